@@ -1,0 +1,334 @@
+#include "engine/lattice/fluid_lattice.hpp"
+
+#include <omp.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <string>
+
+namespace flocsim::lattice {
+
+using namespace d3q19;
+
+namespace {
+
+constexpr std::size_t kPageBytes = 4096;
+// Distance between direction arrays is 4 KiB * k + 192 bytes, so the 19
+// streams start at 19 different offsets within a page (192 * 18 < 4096).
+constexpr std::size_t kStrideSkewBytes = 192;
+
+int wrap(int i, int n) {
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+// Collision parameters in the kernel's precision.
+template <class Real>
+struct CollisionConstants {
+  Real omega_plus, omega_minus;
+  Real force_plus, force_minus;  // 1 - omega/2 of the symmetric / antisymmetric parts
+};
+
+// TRT collision with Guo forcing, on the deviations f_i - w_i of one cell, in
+// place. F is the force density acting on the cell.
+template <class Real>
+inline __attribute__((always_inline)) void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
+                                                   const CollisionConstants<Real>& k) {
+  Real drho = 0;
+#pragma GCC unroll 19
+  for (int i = 0; i < kQ; ++i) drho += f[i];
+  const Real rho = Real(1) + drho;
+  const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
+  const Real jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
+  const Real jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
+  const Real inv_rho = Real(1) / rho;
+  const Real ux = (jx + Real(0.5) * Fx) * inv_rho;
+  const Real uy = (jy + Real(0.5) * Fy) * inv_rho;
+  const Real uz = (jz + Real(0.5) * Fz) * inv_rho;
+  const Real usq15 = Real(1.5) * (ux * ux + uy * uy + uz * uz);
+  const Real uF3 = Real(3) * (ux * Fx + uy * Fy + uz * Fz);
+
+  // Rest population: symmetric only.
+  {
+    const Real w0 = Real(kWeightRest);
+    const Real eq = w0 * (drho - rho * usq15);
+    f[0] += -k.omega_plus * (f[0] - eq) - k.force_plus * w0 * uF3;
+  }
+  // Moving populations, one opposite pair (i, i+1) at a time; c = c_i.
+#pragma GCC unroll 9
+  for (int i = 1; i < kQ; i += 2) {
+    const Real wi = Real(w[i]);
+    const Real cu = Real(cx[i]) * ux + Real(cy[i]) * uy + Real(cz[i]) * uz;
+    const Real cF = Real(cx[i]) * Fx + Real(cy[i]) * Fy + Real(cz[i]) * Fz;
+    const Real eq_plus = wi * (drho + rho * (Real(4.5) * cu * cu - usq15));
+    const Real eq_minus = wi * rho * Real(3) * cu;
+    const Real force_plus = wi * (Real(9) * cu * cF - uF3);
+    const Real force_minus = wi * Real(3) * cF;
+    const Real f_plus = Real(0.5) * (f[i] + f[i + 1]);
+    const Real f_minus = Real(0.5) * (f[i] - f[i + 1]);
+    const Real d_plus = -k.omega_plus * (f_plus - eq_plus) + k.force_plus * force_plus;
+    const Real d_minus = -k.omega_minus * (f_minus - eq_minus) + k.force_minus * force_minus;
+    f[i] += d_plus + d_minus;
+    f[i + 1] += d_plus - d_minus;
+  }
+}
+
+}  // namespace
+
+template <class Real>
+void FluidLattice<Real>::FreeAligned::operator()(Real* p) const {
+  std::free(p);
+}
+
+template <class Real>
+typename FluidLattice<Real>::Buffer FluidLattice<Real>::allocate(std::size_t elements) {
+  std::size_t bytes = elements * sizeof(Real);
+  bytes = (bytes + kPageBytes - 1) / kPageBytes * kPageBytes;
+  void* p = std::aligned_alloc(kPageBytes, bytes);
+  if (!p) throw std::bad_alloc();
+  return Buffer(static_cast<Real*>(p));
+}
+
+template <class Real>
+FluidLattice<Real>::FluidLattice(Extent extent, Relaxation relaxation)
+    : extent_(extent), relaxation_(relaxation) {
+  if (extent.nx < 1 || extent.ny < 1 || extent.nz < 1)
+    throw std::invalid_argument("lattice extent must be at least 1 cell in each direction, got " +
+                                std::to_string(extent.nx) + " x " + std::to_string(extent.ny) +
+                                " x " + std::to_string(extent.nz));
+  relaxation_.check();
+  const std::size_t page_elements = kPageBytes / sizeof(Real);
+  const std::size_t cells = static_cast<std::size_t>(extent.cells());
+  stride_ = static_cast<long>((cells + page_elements - 1) / page_elements * page_elements +
+                              kStrideSkewBytes / sizeof(Real));
+  populations_ = allocate(static_cast<std::size_t>(stride_) * kQ);
+  // First touch in the same static (z, y) schedule as the kernel, so each
+  // thread's pages sit near it on NUMA machines.
+  Real* base = populations_.get();
+  const long stride = stride_;
+  const int nx = extent.nx, ny = extent.ny, nz = extent.nz;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int i = 0; i < kQ; ++i)
+        std::memset(base + i * stride + static_cast<long>(nx) * (y + static_cast<long>(ny) * z), 0,
+                    sizeof(Real) * static_cast<std::size_t>(nx));
+}
+
+template <class Real>
+FluidLattice<Real>::~FluidLattice() = default;
+
+template <class Real>
+void FluidLattice<Real>::enable_force_field() {
+  if (has_force_field()) return;
+  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
+  force_x_ = allocate(cells);
+  force_y_ = allocate(cells);
+  force_z_ = allocate(cells);
+  std::memset(force_x_.get(), 0, cells * sizeof(Real));
+  std::memset(force_y_.get(), 0, cells * sizeof(Real));
+  std::memset(force_z_.get(), 0, cells * sizeof(Real));
+}
+
+template <class Real>
+Real* FluidLattice<Real>::force_field(int component) {
+  return component == 0 ? force_x_.get() : component == 1 ? force_y_.get() : force_z_.get();
+}
+
+template <class Real>
+const Real* FluidLattice<Real>::force_field(int component) const {
+  return component == 0 ? force_x_.get() : component == 1 ? force_y_.get() : force_z_.get();
+}
+
+template <class Real>
+long FluidLattice<Real>::wrapped_index(int x, int y, int z) const {
+  return cell_index(wrap(x, extent_.nx), wrap(y, extent_.ny), wrap(z, extent_.nz));
+}
+
+template <class Real>
+double FluidLattice<Real>::population(int i, int x, int y, int z) const {
+  // Even time: f_i(x) in slot i at x. Odd time (after an even step): the
+  // post-collision value that streams into x along c_i was left in the
+  // opposite slot of the upstream cell x - c_i.
+  const double dev = time_step_ % 2 == 0
+                         ? storage(i)[wrapped_index(x, y, z)]
+                         : storage(opposite(i))[wrapped_index(x - cx[i], y - cy[i], z - cz[i])];
+  return w[i] + dev;
+}
+
+template <class Real>
+Macroscopic FluidLattice<Real>::macroscopic(int x, int y, int z) const {
+  double drho = 0, j[3] = {0, 0, 0};
+  for (int i = 0; i < kQ; ++i) {
+    const double dev = population(i, x, y, z) - w[i];
+    drho += dev;
+    j[0] += cx[i] * dev;
+    j[1] += cy[i] * dev;
+    j[2] += cz[i] * dev;
+  }
+  double F[3] = {body_force_.x, body_force_.y, body_force_.z};
+  if (has_force_field()) {
+    const long c = wrapped_index(x, y, z);
+    for (int d = 0; d < 3; ++d) F[d] += force_field(d)[c];
+  }
+  Macroscopic m;
+  m.density = 1.0 + drho;
+  m.velocity = {(j[0] + 0.5 * F[0]) / m.density, (j[1] + 0.5 * F[1]) / m.density,
+                (j[2] + 0.5 * F[2]) / m.density};
+  return m;
+}
+
+template <class Real>
+void FluidLattice<Real>::macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,
+                                            std::vector<double>& uy,
+                                            std::vector<double>& uz) const {
+  const long n = extent_.cells();
+  density.resize(static_cast<std::size_t>(n));
+  ux.resize(density.size());
+  uy.resize(density.size());
+  uz.resize(density.size());
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int z = 0; z < extent_.nz; ++z)
+    for (int y = 0; y < extent_.ny; ++y)
+      for (int x = 0; x < extent_.nx; ++x) {
+        const Macroscopic m = macroscopic(x, y, z);
+        const auto c = static_cast<std::size_t>(cell_index(x, y, z));
+        density[c] = m.density;
+        ux[c] = m.velocity.x;
+        uy[c] = m.velocity.y;
+        uz[c] = m.velocity.z;
+      }
+}
+
+template <class Real>
+double FluidLattice<Real>::total_mass() const {
+  // The sum of the deviations is the mass excess over the rest density;
+  // summing it alone keeps the round-off of the sum at the level of the excess.
+  double excess = 0;
+  const long n = extent_.cells();
+#pragma omp parallel for reduction(+ : excess) schedule(static)
+  for (long c = 0; c < n; ++c) {
+    double cell = 0;
+    for (int i = 0; i < kQ; ++i) cell += storage(i)[c];
+    excess += cell;
+  }
+  return static_cast<double>(n) + excess;
+}
+
+template <class Real>
+Vector3 FluidLattice<Real>::total_momentum() const {
+  double px = 0, py = 0, pz = 0;
+#pragma omp parallel for collapse(2) reduction(+ : px, py, pz) schedule(static)
+  for (int z = 0; z < extent_.nz; ++z)
+    for (int y = 0; y < extent_.ny; ++y)
+      for (int x = 0; x < extent_.nx; ++x) {
+        const Macroscopic m = macroscopic(x, y, z);
+        px += m.density * m.velocity.x;
+        py += m.density * m.velocity.y;
+        pz += m.density * m.velocity.z;
+      }
+  return {px, py, pz};
+}
+
+template <class Real>
+std::size_t FluidLattice<Real>::bytes_per_cell_update() const {
+  return (2 * kQ + (has_force_field() ? 3 : 0)) * sizeof(Real);
+}
+
+template <class Real>
+void FluidLattice<Real>::step() {
+  if (has_force_field())
+    step_kernel<true>();
+  else
+    step_kernel<false>();
+  ++time_step_;
+}
+
+template <class Real>
+template <bool kForceField>
+void FluidLattice<Real>::step_kernel() {
+  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
+  const bool even = time_step_ % 2 == 0;
+  CollisionConstants<Real> k;
+  k.omega_plus = static_cast<Real>(relaxation_.omega_plus());
+  k.omega_minus = static_cast<Real>(relaxation_.omega_minus());
+  k.force_plus = static_cast<Real>(1.0 - 0.5 * relaxation_.omega_plus());
+  k.force_minus = static_cast<Real>(1.0 - 0.5 * relaxation_.omega_minus());
+  const Real bx = static_cast<Real>(body_force_.x);
+  const Real by = static_cast<Real>(body_force_.y);
+  const Real bz = static_cast<Real>(body_force_.z);
+  Real* const base = populations_.get();
+  const long stride = stride_;
+  const Real* const Fxs = force_x_.get();
+  const Real* const Fys = force_y_.get();
+  const Real* const Fzs = force_z_.get();
+
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+      // Per direction: where this row's incoming populations are read and its
+      // outgoing ones written, as pointers indexed by x.
+      const Real* load[kQ];
+      Real* store[kQ];
+      for (int i = 0; i < kQ; ++i) {
+        if (even) {
+          load[i] = base + i * stride + row;
+          store[i] = base + opposite(i) * stride + row;
+        } else {
+          const long up = static_cast<long>(nx) * (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
+          const long down = static_cast<long>(nx) * (wrap(y + cy[i], ny) + static_cast<long>(ny) * wrap(z + cz[i], nz));
+          load[i] = base + opposite(i) * stride + up - cx[i];
+          store[i] = base + i * stride + down + cx[i];
+        }
+      }
+      const Real* Fx = kForceField ? Fxs + row : nullptr;
+      const Real* Fy = kForceField ? Fys + row : nullptr;
+      const Real* Fz = kForceField ? Fzs + row : nullptr;
+
+      auto update = [&](int x, const Real* const* ld, Real* const* st, int lx, int sx)
+                        __attribute__((always_inline)) {
+        Real f[kQ];
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
+        Real Fcx = bx, Fcy = by, Fcz = bz;
+        if constexpr (kForceField) {
+          Fcx += Fx[x];
+          Fcy += Fy[x];
+          Fcz += Fz[x];
+        }
+        collide(f, Fcx, Fcy, Fcz, k);
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
+      };
+
+      // Interior of the row: every shifted pointer stays inside the row, so
+      // the loop is a plain unit-stride sweep the compiler vectorises.
+      const int x_begin = even ? 0 : 1;
+      const int x_end = even ? nx : nx - 1;
+#pragma omp simd
+      for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
+
+      // Odd steps: the two end cells of the row stream across the periodic
+      // boundary in x; give them explicitly wrapped pointers.
+      if (!even) {
+        for (int x : {0, nx - 1}) {
+          if (x == nx - 1 && nx == 1) break;
+          const Real* ld[kQ];
+          Real* st[kQ];
+          for (int i = 0; i < kQ; ++i) {
+            ld[i] = load[i] + cx[i] + wrap(x - cx[i], nx);
+            st[i] = store[i] - cx[i] + wrap(x + cx[i], nx);
+          }
+          update(x, ld, st, 0, 0);
+        }
+      }
+    }
+}
+
+template class FluidLattice<float>;
+template class FluidLattice<double>;
+
+}  // namespace flocsim::lattice
