@@ -1,0 +1,59 @@
+// flocsim: particle-resolved simulations of settling, flocculating spheres and
+// the tools around them. Subcommands register themselves (command_registry.hpp).
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <map>
+
+#include "apps/flocsim/command_registry.hpp"
+
+namespace flocsim::app {
+
+namespace {
+std::vector<Command>& registry() {
+  static std::vector<Command> r;
+  return r;
+}
+}  // namespace
+
+bool register_command(Command command) {
+  registry().push_back(std::move(command));
+  return true;
+}
+
+const std::vector<Command>& commands() { return registry(); }
+
+}  // namespace flocsim::app
+
+int main(int argc, char** argv) {
+  using namespace flocsim::app;
+  CLI::App app{"flocsim " FLOCSIM_VERSION
+               ": particle-resolved simulation of settling, flocculating spheres\n"
+               "(lattice Boltzmann D3Q19 + immersed boundary + event-driven contacts)"};
+  app.set_version_flag("--version", FLOCSIM_VERSION);
+  app.require_subcommand(1);
+  std::vector<Command> sorted = commands();
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Command& a, const Command& b) { return a.name < b.name; });
+  std::map<CLI::App*, CommandHandler> handlers;
+  for (const Command& c : sorted) {
+    CLI::App* sub = app.add_subcommand(c.name, c.description);
+    handlers[sub] = c.setup(*sub);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+  for (auto& [sub, handler] : handlers) {
+    if (!sub->parsed()) continue;
+    try {
+      return handler();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "flocsim %s: error: %s\n", sub->get_name().c_str(), e.what());
+      return kExitFailure;
+    }
+  }
+  return kExitBadInput;
+}
