@@ -1,0 +1,78 @@
+// flocsim run CASE.json --out DIR [--resume] [--quiet]
+// One solver instance; also what the orchestrator's workers execute.
+// Exit codes: 0 completed, 1 failed, 2 input refused, 3 stopped by a signal
+// after writing a checkpoint (continue with --resume).
+#include <cstdio>
+
+#include "apps/flocsim/command_registry.hpp"
+#include "engine/case/fluid_case.hpp"
+#include "engine/input/input_reader.hpp"
+#include "engine/run/fluid_run.hpp"
+#include "engine/run/stop_signal.hpp"
+
+namespace flocsim::app {
+namespace {
+
+struct RunArguments {
+  std::string case_file;
+  std::string out_dir;
+  bool resume = false;
+  bool quiet = false;
+  long stop_after_steps = 0;
+};
+
+int run_command(const RunArguments& a) {
+  cases::FluidCase c;
+  try {
+    const nlohmann::json document = input::read_json_file(a.case_file);
+    const std::string scene = document.is_object() && document.contains("scene") && document["scene"].is_string()
+                                  ? document["scene"].get<std::string>()
+                                  : "";
+    if (scene != "fluid")
+      throw input::InputError("scene = " + (document.is_object() && document.contains("scene")
+                                                ? document["scene"].dump()
+                                                : std::string("(missing)")) +
+                              ": must be one of \"fluid\"");
+    c = cases::parse_fluid_case(document);
+  } catch (const input::InputError& e) {
+    std::fprintf(stderr, "flocsim run: input error in %s: %s\n", a.case_file.c_str(), e.what());
+    return kExitBadInput;
+  }
+  run::install_stop_handlers();
+  run::RunOptions options;
+  options.out_dir = a.out_dir;
+  options.resume = a.resume;
+  options.quiet = a.quiet;
+  options.stop_after_steps = a.stop_after_steps;
+  run::RunReport report;
+  try {
+    report = run::run_fluid_case(c, options);
+  } catch (const input::InputError& e) {
+    std::fprintf(stderr, "flocsim run: input error: %s\n", e.what());
+    return kExitBadInput;
+  }
+  switch (report.outcome) {
+    case run::RunOutcome::completed: return kExitOk;
+    case run::RunOutcome::interrupted: return kExitInterrupted;
+    case run::RunOutcome::failed:
+      std::fprintf(stderr, "flocsim run: failed: %s\n", report.message.c_str());
+      return kExitFailure;
+  }
+  return kExitFailure;
+}
+
+const bool registered = register_command(
+    {"run", "Run one simulation case (also the orchestrator's worker)", [](CLI::App& cmd) {
+       auto args = std::make_shared<RunArguments>();
+       cmd.add_option("case", args->case_file, "Case file (JSON)")->required()->check(CLI::ExistingFile);
+       cmd.add_option("--out,-o", args->out_dir, "Output directory")->required();
+       cmd.add_flag("--resume", args->resume, "Continue from OUT/checkpoint.h5 if it exists");
+       cmd.add_flag("--quiet,-q", args->quiet, "Write only the log file, nothing on stderr");
+       cmd.add_option("--stop-after", args->stop_after_steps,
+                      "Stop after N steps as if SIGTERM arrived (checkpoint, exit 3); for tests")
+           ->check(CLI::NonNegativeNumber);
+       return [args] { return run_command(*args); };
+     }});
+
+}  // namespace
+}  // namespace flocsim::app
