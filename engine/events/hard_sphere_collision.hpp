@@ -14,6 +14,7 @@
 // P_t = -(m/7) G_ct. Coulomb's law bounds it by mu_f |P_n|: if
 // |G_ct| > (7/2) mu_f (1 + e) (G.n) the contact slides all through the
 // collision and P_t = -mu_f |P_n| G_ct / |G_ct|.
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "engine/spheres/sphere_set.hpp"

@@ -7,6 +7,7 @@
 // "stable quadratic" form c / (-b + sqrt(D)) for the near root), and the
 // discriminant D = b^2 - vv c is evaluated as vv R^2 - |r x v|^2, which has no
 // cancellation between b^2 and vv r.r when the pair is far apart.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
