@@ -1,0 +1,94 @@
+#include "engine/observables/suspension_averages.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace flocsim::observables {
+
+double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x, double phi) {
+  return (1.0 - phi) * (liquid_mean_velocity_x - sphere_mean_velocity_x);
+}
+
+double dimensionless_drag(double body_force_density, double radius, double phi, double viscosity,
+                          double slip_velocity) {
+  const double hydrodynamic_force = body_force_density * 4.0 / 3.0 * M_PI * radius * radius * radius * (1.0 / phi - 1.0);
+  return hydrodynamic_force / (6.0 * M_PI * radius * viscosity * slip_velocity);
+}
+
+double granular_temperature(const std::vector<spheres::Vec3>& velocity) {
+  if (velocity.empty()) return 0.0;
+  spheres::Vec3 mean = spheres::Vec3::Zero();
+  for (const auto& v : velocity) mean += v;
+  mean /= static_cast<double>(velocity.size());
+  double sum = 0;
+  for (const auto& v : velocity) sum += (v - mean).squaredNorm();
+  return sum / (3.0 * static_cast<double>(velocity.size()));
+}
+
+std::vector<double> slab_solids_fraction(const std::vector<spheres::Vec3>& position, double radius,
+                                         const spheres::PeriodicBox& box, int slabs) {
+  if (slabs < 1) throw std::invalid_argument("slab_solids_fraction: slabs must be >= 1");
+  const double L = box.length.x(), width = L / slabs;
+  std::vector<double> volume(static_cast<std::size_t>(slabs), 0.0);
+  // Volume of a sphere between planes at offsets t0 < t1 from its centre
+  // (clipped to [-a, a]): pi [a^2 t - t^3 / 3] from t0 to t1.
+  auto cap = [radius](double t0, double t1) {
+    t0 = std::max(t0, -radius);
+    t1 = std::min(t1, radius);
+    if (t1 <= t0) return 0.0;
+    auto prim = [radius](double t) { return radius * radius * t - t * t * t / 3.0; };
+    return M_PI * (prim(t1) - prim(t0));
+  };
+  for (const auto& p : position) {
+    const double xc = p.x() - L * std::floor(p.x() / L);
+    // the sphere spans [xc - a, xc + a]; its images at xc +- L cover the wrap
+    for (double image : {xc - L, xc, xc + L}) {
+      const int first = std::max(0, static_cast<int>(std::floor((image - radius) / width)));
+      const int last = std::min(slabs - 1, static_cast<int>(std::floor((image + radius) / width)));
+      for (int s = first; s <= last; ++s) volume[s] += cap(s * width - image, (s + 1) * width - image);
+    }
+  }
+  const double slab_volume = width * box.length.y() * box.length.z();
+  for (double& v : volume) v /= slab_volume;
+  return volume;
+}
+
+SteadyAverage batch_means(const std::vector<double>& series, int batches) {
+  SteadyAverage out;
+  out.samples = static_cast<long>(series.size());
+  if (series.empty()) return out;
+  if (batches < 2) throw std::invalid_argument("batch_means: at least 2 batches are needed");
+  const long per = out.samples / batches;
+  if (per < 1) throw std::invalid_argument("batch_means: fewer samples than batches");
+  // use the last batches * per samples (the most recent, most stationary part)
+  const long start = out.samples - per * batches;
+  std::vector<double> means(static_cast<std::size_t>(batches), 0.0);
+  for (int b = 0; b < batches; ++b) {
+    double s = 0;
+    for (long k = 0; k < per; ++k) s += series[start + b * per + k];
+    means[b] = s / per;
+  }
+  double mean = 0;
+  for (double m : means) mean += m;
+  mean /= batches;
+  double var = 0;
+  for (double m : means) var += (m - mean) * (m - mean);
+  var /= (batches - 1);
+  out.mean = mean;
+  out.error = std::sqrt(var / batches);
+  out.batches = batches;
+  out.samples = per * batches;
+  return out;
+}
+
+bool is_stationary(const std::vector<double>& series, long window, double tolerance) {
+  const long n = static_cast<long>(series.size());
+  if (window < 5 || n < 2 * window) return false;
+  const std::vector<double> older(series.end() - 2 * window, series.end() - window);
+  const std::vector<double> newer(series.end() - window, series.end());
+  const SteadyAverage a = batch_means(older, 5), b = batch_means(newer, 5);
+  const double spread = std::hypot(a.error, b.error);
+  return std::abs(a.mean - b.mean) <= tolerance * spread;
+}
+
+}  // namespace flocsim::observables

@@ -1,0 +1,46 @@
+#pragma once
+// The settling observables of SPEC section 4 that are plain formulas of
+// averages, the slab solids fraction phi(x), and the steady-state statistics
+// (batch means) with which their time series are summarised.
+#include <vector>
+
+#include "engine/spheres/sphere_set.hpp"
+
+namespace flocsim::observables {
+
+// U = (1 - phi)(<u> - <u_p>) along x: <u> over the liquid volume, <u_p> over
+// the solid volume.
+double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x, double phi);
+
+// F = F_h / (6 pi a nu rho U) with F_h = f (4/3) pi a^3 (1/phi - 1), f the body
+// force density on the liquid (rho = 1 in lattice units).
+double dimensionless_drag(double body_force_density, double radius, double phi, double viscosity,
+                          double slip_velocity);
+
+// T = (1/3) <|u_p - <u_p>|^2>: the granular temperature.
+double granular_temperature(const std::vector<spheres::Vec3>& velocity);
+
+// Solids volume fraction of `slabs` equal slabs normal to x, from the exact
+// volume of each sphere (and its periodic images) inside each slab.
+std::vector<double> slab_solids_fraction(const std::vector<spheres::Vec3>& position, double radius,
+                                         const spheres::PeriodicBox& box, int slabs);
+
+// Mean of a stationary time series with its standard error from batch means:
+// the series is cut into `batches` consecutive batches whose means are close
+// to independent when a batch is much longer than the correlation time; the
+// error is their standard deviation over sqrt(batches).
+struct SteadyAverage {
+  double mean = 0;
+  double error = 0;
+  long samples = 0;
+  int batches = 0;
+};
+SteadyAverage batch_means(const std::vector<double>& series, int batches);
+
+// Dynamically stationary: the means of the last two windows of `window`
+// samples differ by less than `tolerance` standard errors of their difference
+// (batch-means errors, 5 batches per window). False while fewer than
+// 2 * window samples exist.
+bool is_stationary(const std::vector<double>& series, long window, double tolerance = 2.0);
+
+}  // namespace flocsim::observables
