@@ -1,0 +1,196 @@
+#include "engine/case/suspension_case.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "engine/case/fluid_case.hpp"
+#include "engine/input/input_reader.hpp"
+
+namespace flocsim::cases {
+
+using input::InputError;
+using input::InputReader;
+using input::Range;
+
+namespace {
+
+std::string format(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+// Resolution, domain and durations of each fidelity preset. The paper preset
+// is the paper's default case (a = 6 dx, L = 48a, L/W = 2); standard keeps
+// the resolution and shrinks the domain (the paper saw <= 4 % domain-size
+// effect on F); draft is for quick looks and CI.
+struct Preset {
+  double radius_cells, length_over_a, stage1_min, stage1_max, stage2_settle, statistics;
+};
+Preset preset(const std::string& fidelity) {
+  if (fidelity == "draft") return {4, 16, 5, 20, 10, 20};
+  if (fidelity == "standard") return {6, 32, 20, 100, 50, 100};
+  return {6, 48, 30, 150, 100, 300};  // paper
+}
+
+}  // namespace
+
+double schiller_naumann_drag_coefficient(double reynolds) {
+  return 24.0 / reynolds * (1.0 + 0.15 * std::pow(reynolds, 0.687));
+}
+
+SuspensionCase parse_suspension_case(const nlohmann::json& document) {
+  SuspensionCase c;
+  InputReader root(document, "");
+  c.scene = root.choice("scene", {"suspension", "fixed-array", "single-sphere", "granular"});
+  c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
+  const Preset p = preset(c.fidelity);
+  c.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
+  c.seed = static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
+
+  const bool single = c.scene == "single-sphere";
+  if (!single) c.phi = root.number("phi", {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
+  c.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
+  c.density_ratio = root.number("density_ratio", {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
+  c.du_over_uinf = root.number("du_over_Uinf", {.at_least = 0, .at_most = 0.5}, 0.0);
+  c.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
+  c.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
+  c.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
+  c.lubrication_onset_over_a = root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
+  c.lubrication_saturation_over_a =
+      root.number("lubrication_saturation_over_a", {.above = 0, .below = c.lubrication_onset_over_a,
+                                                    .why = "(below lubrication_onset_over_a)"},
+                  2e-4);
+  c.length_over_a = root.number("L_over_a", {.at_least = 8, .at_most = 256}, p.length_over_a);
+  c.length_over_width = root.number("L_over_W", {.at_least = 0.25, .at_most = 8}, 2.0);
+
+  InputReader num = root.object("numerics");
+  c.radius_cells = num.number("a_over_dx", {.at_least = 3, .at_most = 24}, p.radius_cells);
+  const bool has_nu = num.has("viscosity"), has_u = num.has("U_inf");
+  if (has_nu && has_u)
+    throw InputError("numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the other through Re_inf)");
+  const double a = c.radius_cells;
+  if (has_nu) {
+    c.viscosity = num.number("viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
+    c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
+  } else {
+    const Range u_range{.above = 0, .at_most = kMaxSettlingVelocity, .why = "(Mach limit for settling flows)"};
+    c.settling_velocity = num.number("U_inf", u_range, kDefaultSettlingVelocity);
+    c.viscosity = c.settling_velocity * 2 * a / c.reynolds_inf;
+    // by default stay inside the tested viscosity range: lower U_inf instead
+    if (!has_u && c.viscosity < kSmallestTestedViscosity) {
+      c.viscosity = kSmallestTestedViscosity;
+      c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
+    }
+  }
+  c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
+  num.finish();
+  if (c.settling_velocity > kMaxSettlingVelocity)
+    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format(c.reynolds_inf) + " * " + format(c.viscosity) +
+                     " / " + format(2 * a) + " = " + format(c.settling_velocity) + ": must be <= " +
+                     format(kMaxSettlingVelocity) + " (Mach limit for settling flows); lower numerics.viscosity");
+  if (c.viscosity < kSmallestTestedViscosity)
+    c.warnings.push_back("viscosity = " + format(c.viscosity) + " is below the smallest tested (" +
+                         format(kSmallestTestedViscosity) + ", tau = 0.515)");
+
+  InputReader pr = root.object("protocol");
+  const Range duration{.at_least = 0, .at_most = 1e5};
+  c.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
+  c.stage1_max = pr.number("stage1_max", {.at_least = c.stage1_min, .at_most = 1e5,
+                                           .why = "(at least protocol.stage1_min)"},
+                           p.stage1_max);
+  c.stage2_settle = pr.number("stage2_settle", duration, p.stage2_settle);
+  c.statistics = pr.number("statistics", {.above = 0, .at_most = 1e5}, p.statistics);
+  c.sample_every = pr.number("sample_every", {.above = 0, .at_most = 100}, 0.5);
+  c.stationarity_window = pr.number("stationarity_window", {.above = 0, .at_most = 1e4}, 20.0);
+  c.snapshot_every = pr.number("snapshot_every", duration, 10.0);
+  c.checkpoint_every_s = pr.number("checkpoint_every_s", {.above = 0}, 600.0);
+  c.progress_every_s = pr.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
+  c.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
+  pr.finish();
+  if (c.statistics < 5 * c.sample_every)
+    throw InputError("protocol.statistics = " + format(c.statistics) + ": must be >= 5 x protocol.sample_every = " +
+                     format(5 * c.sample_every) + " (batch means need samples)");
+  root.finish();
+
+  // ---- lattice-unit quantities (SPEC section 2) -----------------------------
+  const int L = static_cast<int>(std::lround(c.length_over_a * a));
+  const int W = static_cast<int>(std::lround(L / c.length_over_width));
+  c.box = {L, W, W};
+  if (W < 4 * a)
+    throw InputError("L_over_W = " + format(c.length_over_width) + ": makes the box width W = " + std::to_string(W) +
+                     " cells, less than 4a = " + format(4 * a) + "; must leave room for a sphere and its neighbours");
+  const double volume = static_cast<double>(L) * W * W;
+  const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
+  c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));
+  if (c.sphere_count < 1)
+    throw InputError("phi = " + format(c.phi) + ": gives N = 0 spheres in this box; raise phi or L_over_a");
+  c.phi_realised = c.sphere_count * sphere_volume / volume;
+  if (single) c.phi = c.phi_realised;
+
+  c.drag_coefficient = schiller_naumann_drag_coefficient(c.reynolds_inf);
+  const double U = c.settling_velocity;
+  c.gravity = 0.375 * c.drag_coefficient * U * U / ((c.density_ratio - 1.0) * a);
+  c.convective_time = a / U;
+  c.escape_velocity = c.du_over_uinf * U;
+  c.well_width = c.delta_over_a * a;
+  // rho_bar - rho = phi (rho_p - rho); rho_p - rho_bar = (1 - phi)(rho_p - rho)
+  c.liquid_body_force = c.phi_realised * (c.density_ratio - 1.0) * c.gravity;
+  c.sphere_net_gravity = (1.0 - c.phi_realised) * (c.density_ratio - 1.0) * sphere_volume * c.gravity;
+
+  const double bytes = static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
+  const double available = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (c.scene != "granular" && available > 0 && bytes > 0.8 * available)
+    throw InputError("L_over_a = " + format(c.length_over_a) + ", a_over_dx = " + format(a) + ": the " +
+                     std::to_string(L) + " x " + std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
+                     format(bytes / 1e9) + " GB; must fit in 80 % of this machine's " + format(available / 1e9) + " GB");
+  return c;
+}
+
+nlohmann::json SuspensionCase::to_json() const {
+  nlohmann::json j;
+  j["scene"] = scene;
+  j["fidelity"] = fidelity;
+  j["precision"] = single_precision ? "float" : "double";
+  j["seed"] = seed;
+  if (scene != "single-sphere") j["phi"] = phi;
+  j["Re_inf"] = reynolds_inf;
+  j["density_ratio"] = density_ratio;
+  j["du_over_Uinf"] = du_over_uinf;
+  j["delta_over_a"] = delta_over_a;
+  j["restitution"] = restitution;
+  j["friction"] = friction;
+  j["lubrication_onset_over_a"] = lubrication_onset_over_a;
+  j["lubrication_saturation_over_a"] = lubrication_saturation_over_a;
+  j["L_over_a"] = length_over_a;
+  j["L_over_W"] = length_over_width;
+  j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
+  j["protocol"] = {{"stage1_min", stage1_min},         {"stage1_max", stage1_max},
+                   {"stage2_settle", stage2_settle},   {"statistics", statistics},
+                   {"sample_every", sample_every},     {"stationarity_window", stationarity_window},
+                   {"snapshot_every", snapshot_every}, {"checkpoint_every_s", checkpoint_every_s},
+                   {"progress_every_s", progress_every_s}, {"threads", threads}};
+  return j;
+}
+
+nlohmann::json SuspensionCase::derived_json() const {
+  return {{"box_cells", {box.nx, box.ny, box.nz}},
+          {"sphere_count", sphere_count},
+          {"phi_realised", phi_realised},
+          {"U_inf", settling_velocity},
+          {"viscosity", viscosity},
+          {"tau", 3 * viscosity + 0.5},
+          {"C_D", drag_coefficient},
+          {"gravity", gravity},
+          {"convective_time_steps", convective_time},
+          {"escape_velocity", escape_velocity},
+          {"well_width", well_width},
+          {"liquid_body_force", liquid_body_force},
+          {"sphere_net_gravity", sphere_net_gravity},
+          {"Mach_U_inf", settling_velocity * std::sqrt(3.0)}};
+}
+
+}  // namespace flocsim::cases

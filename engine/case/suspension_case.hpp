@@ -1,0 +1,91 @@
+#pragma once
+// Cases with spheres (SPEC sections 2-3): the dimensionless inputs of the
+// paper's Table 1, numerics and run protocol, converted to lattice units.
+//
+//   {"scene": "suspension", "fidelity": "standard",
+//    "phi": 0.20, "Re_inf": 12, "du_over_Uinf": 0.02,
+//    "numerics": {"a_over_dx": 6}, "protocol": {"statistics": 100}}
+//
+// Scenes: suspension (the full model), fixed-array (spheres held still),
+// single-sphere, granular (spheres with direct interactions and no liquid).
+// Fidelity presets set resolution, domain size and durations; any field given
+// explicitly overrides its preset value. Format: docs/user-guide.md.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/lattice/fluid_lattice.hpp"
+
+namespace flocsim::cases {
+
+// Largest single-sphere settling velocity U_inf accepted, in lattice units.
+// Sphere and liquid velocities in a settling suspension reach a few U_inf
+// locally; 0.05 keeps those below Ma = 0.2 (|u| = 0.115).
+inline constexpr double kMaxSettlingVelocity = 0.05;
+// Default settling velocity when neither viscosity nor U_inf is given: the
+// middle of the paper's range (0.01-0.03).
+inline constexpr double kDefaultSettlingVelocity = 0.02;
+
+struct SuspensionCase {
+  std::string scene = "suspension";
+  std::string fidelity = "standard";
+  bool single_precision = false;
+  std::uint64_t seed = 1;
+
+  // ---- dimensionless inputs (paper Table 1) --------------------------------
+  double phi = 0.20;              // requested solids fraction
+  double reynolds_inf = 12;       // Re_inf = U_inf 2a / nu
+  double density_ratio = 4.0;     // rho_p / rho
+  double du_over_uinf = 0.0;      // square-well strength
+  double delta_over_a = 0.025;    // square-well width
+  double restitution = 1.0;       // e
+  double friction = 0.0;          // mu_f
+  double lubrication_onset_over_a = 0.2;         // s0 / a
+  double lubrication_saturation_over_a = 2e-4;   // s1 / a
+  double length_over_a = 48;      // L / a
+  double length_over_width = 2;   // L / W
+
+  // ---- numerics --------------------------------------------------------------
+  double radius_cells = 6;        // hydrodynamic radius a / dx
+  double viscosity = 0;           // lattice nu (derived when not given)
+  double trt_magic = 0.25;
+
+  // ---- protocol (durations in a / U_inf) -------------------------------------
+  double stage1_min = 20;         // du = 0 stage: at least this long ...
+  double stage1_max = 100;        // ... until stationary, at most this long
+  double stage2_settle = 50;      // du at target: before statistics start
+  double statistics = 100;        // averaging window
+  double sample_every = 0.5;      // time-series cadence
+  double stationarity_window = 20;
+  double checkpoint_every_s = 600;
+  double snapshot_every = 10;     // sphere snapshots, a / U_inf (0: none)
+  double progress_every_s = 2;
+  int threads = 0;
+
+  // ---- derived, lattice units (dx = dt = 1, rho = 1) -------------------------
+  lattice::Extent box;            // cells: L x W x W
+  int sphere_count = 0;           // N
+  double phi_realised = 0;        // N (4/3) pi a^3 / V
+  double settling_velocity = 0;   // U_inf
+  double drag_coefficient = 0;    // C_D (Schiller-Naumann at Re_inf)
+  double gravity = 0;             // g
+  double convective_time = 0;     // a / U_inf in time steps
+  double escape_velocity = 0;     // du
+  double well_width = 0;          // delta
+  double liquid_body_force = 0;   // f = (rho_bar - rho) g, along +x
+  double sphere_net_gravity = 0;  // (rho_p - rho_bar) V_p g, acting along -x
+
+  std::vector<std::string> warnings;
+
+  nlohmann::json to_json() const;      // the canonical case, defaults filled in
+  nlohmann::json derived_json() const; // the lattice-unit quantities, for logs and result.json
+};
+
+// Validates everything before any work starts; throws input::InputError that
+// names the field, the value and the allowed range.
+SuspensionCase parse_suspension_case(const nlohmann::json& document);
+
+// Schiller-Naumann: C_D = 24/Re (1 + 0.15 Re^0.687).
+double schiller_naumann_drag_coefficient(double reynolds);
+
+}  // namespace flocsim::cases
