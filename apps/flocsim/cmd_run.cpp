@@ -2,12 +2,15 @@
 // One solver instance; also what the orchestrator's workers execute.
 // Exit codes: 0 completed, 1 failed, 2 input refused, 3 stopped by a signal
 // after writing a checkpoint (continue with --resume).
+#include <algorithm>
 #include <cstdio>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "engine/case/fluid_case.hpp"
+#include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/run/fluid_run.hpp"
+#include "engine/run/sphere_run.hpp"
 #include "engine/run/stop_signal.hpp"
 
 namespace flocsim::app {
@@ -22,18 +25,25 @@ struct RunArguments {
 };
 
 int run_command(const RunArguments& a) {
-  cases::FluidCase c;
+  // Read and validate the whole case before any work starts.
+  cases::FluidCase fluid_case;
+  cases::SuspensionCase sphere_case;
+  bool fluid_scene = false;
   try {
     const nlohmann::json document = input::read_json_file(a.case_file);
-    const std::string scene = document.is_object() && document.contains("scene") && document["scene"].is_string()
-                                  ? document["scene"].get<std::string>()
-                                  : "";
-    if (scene != "fluid")
-      throw input::InputError("scene = " + (document.is_object() && document.contains("scene")
-                                                ? document["scene"].dump()
-                                                : std::string("(missing)")) +
-                              ": must be one of \"fluid\"");
-    c = cases::parse_fluid_case(document);
+    const nlohmann::json* scene = document.is_object() && document.contains("scene") ? &document["scene"] : nullptr;
+    fluid_scene = scene && scene->is_string() && scene->get<std::string>() == "fluid";
+    if (fluid_scene) {
+      fluid_case = cases::parse_fluid_case(document);
+    } else {
+      sphere_case = cases::parse_suspension_case(document);
+      const auto& runnable = run::runnable_sphere_scenes();
+      if (std::find(runnable.begin(), runnable.end(), sphere_case.scene) == runnable.end()) {
+        std::string list = "\"fluid\"";
+        for (const auto& r : runnable) list += ", \"" + r + "\"";
+        throw input::InputError("scene = \"" + sphere_case.scene + "\": this build runs scenes " + list);
+      }
+    }
   } catch (const input::InputError& e) {
     std::fprintf(stderr, "flocsim run: input error in %s: %s\n", a.case_file.c_str(), e.what());
     return kExitBadInput;
@@ -46,7 +56,7 @@ int run_command(const RunArguments& a) {
   options.stop_after_steps = a.stop_after_steps;
   run::RunReport report;
   try {
-    report = run::run_fluid_case(c, options);
+    report = fluid_scene ? run::run_fluid_case(fluid_case, options) : run::run_sphere_case(sphere_case, options);
   } catch (const input::InputError& e) {
     std::fprintf(stderr, "flocsim run: input error: %s\n", e.what());
     return kExitBadInput;

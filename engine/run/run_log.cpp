@@ -90,6 +90,8 @@ void ProgressReporter::update(long step, const std::string& extra) {
 
 void ProgressReporter::finish(long step) { report(step, ""); }
 
+void ProgressReporter::set_steps_total(long steps_total) { steps_total_ = steps_total; }
+
 void ProgressReporter::report(long step, const std::string& extra) {
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
@@ -100,9 +102,11 @@ void ProgressReporter::report(long step, const std::string& extra) {
   const double m = mlups(step);
   if (std::chrono::duration<double>(now - last_print_).count() >= every_s_ || step == steps_total_) {
     char line[256];
-    std::snprintf(line, sizeof line, "step %ld/%ld (%5.1f%%) | %7.1f MLUPS | ETA %s%s%s", step,
-                  steps_total_, 100 * fraction, m, format_duration(eta).c_str(),
-                  extra.empty() ? "" : " | ", extra.c_str());
+    char rate_text[32] = "";
+    if (cells_ > 0) std::snprintf(rate_text, sizeof rate_text, " | %7.1f MLUPS", m);
+    std::snprintf(line, sizeof line, "step %ld/%ld (%5.1f%%)%s | ETA %s%s%s", step, steps_total_,
+                  100 * fraction, rate_text, format_duration(eta).c_str(), extra.empty() ? "" : " | ",
+                  extra.c_str());
     log_.progress_line(line);
   }
   nlohmann::json j = {{"step", step},

@@ -36,7 +36,8 @@ struct ProgressSnapshot {
 };
 
 // Reports progress at most every `every_s` seconds on the log and rewrites
-// progress.json at most every min(every_s, 5) seconds.
+// progress.json at most every min(every_s, 5) seconds. `cells` is the number
+// of lattice cells updated per step (0 for runs without a liquid: no MLUPS).
 class ProgressReporter {
  public:
   ProgressReporter(RunLog& log, std::filesystem::path progress_json, long first_step,
@@ -45,6 +46,8 @@ class ProgressReporter {
   void update(long step, const std::string& extra = "");
   // Forces a final report.
   void finish(long step);
+  // Runs whose length is decided on the way (stationarity) revise their total.
+  void set_steps_total(long steps_total);
   double mlups(long step) const;
 
  private:
