@@ -38,6 +38,8 @@ void DirectInteractionParams::check() const {
     throw std::invalid_argument(describe_range("escape_velocity", escape_velocity, "[0, inf)"));
   if (!(well_width > 0 && std::isfinite(well_width)))
     throw std::invalid_argument(describe_range("well_width", well_width, "(0, inf)"));
+  if (!(contact_duration >= 0 && std::isfinite(contact_duration)))
+    throw std::invalid_argument(describe_range("contact_duration", contact_duration, "[0, inf)"));
   if (!(max_events_per_sphere > 0))
     throw std::invalid_argument(
         describe_range("max_events_per_sphere", max_events_per_sphere, "(0, inf)"));
@@ -174,16 +176,17 @@ void DirectInteractions::predict(const SphereSet& s, int p, double t, double dt)
   const Vec3 v = s.velocity[pair.j] - s.velocity[pair.i];
   const double a = s.radius;
   const double well_edge = 2.0 * (a + params_.well_width);
+  const double speed_floor = radial_speed_floor(s.velocity[pair.i], s.velocity[pair.j]);
   double wait;
   Kind kind;
   if (wells_on() && !pair.attached && r.squaredNorm() > well_edge * well_edge) {
-    wait = time_to_close_to(r, v, well_edge);
+    wait = time_to_close_to(r, v, well_edge, speed_floor);
     kind = Kind::well_entry;
   } else {
-    wait = time_to_close_to(r, v, 2.0 * a);
+    wait = time_to_close_to(r, v, 2.0 * a, speed_floor);
     kind = Kind::collision;
     if (pair.attached) {
-      const double to_edge = time_to_open_to(r, v, well_edge);
+      const double to_edge = time_to_open_to(r, v, well_edge, speed_floor);
       if (to_edge < wait) {
         wait = to_edge;
         kind = Kind::well_edge;
@@ -207,17 +210,25 @@ void DirectInteractions::execute(SphereSet& s, const Event& e) {
   const Vec3 n = r / distance;
   const double radial_velocity = (s.velocity[j] - s.velocity[i]).dot(n);
   const double du = params_.escape_velocity;
+  // The same closing/separating test as the prediction (pair_kinematics.hpp).
+  const double speed_floor = radial_speed_floor(s.velocity[i], s.velocity[j]);
 
   switch (e.kind) {
     case Kind::collision: {
-      const HardSphereCollision collide{params_.restitution, params_.friction};
-      if (collide(s.velocity[i], s.angular_velocity[i], s.velocity[j], s.angular_velocity[j], n,
-                  s.radius))
+      const bool within_contact = e.time - last_collision_[i] < params_.contact_duration ||
+                                  e.time - last_collision_[j] < params_.contact_duration;
+      const HardSphereCollision collide{within_contact ? 1.0 : params_.restitution,
+                                        params_.friction};
+      if (radial_velocity < -speed_floor &&
+          collide(s.velocity[i], s.angular_velocity[i], s.velocity[j], s.angular_velocity[j], n,
+                  s.radius)) {
         ++counters_.collisions;
+        last_collision_[i] = last_collision_[j] = e.time;
+      }
       break;
     }
     case Kind::well_entry:
-      if (radial_velocity < 0) {
+      if (radial_velocity < -speed_floor) {
         enter_well(s.velocity[i], s.velocity[j], n, du);
         pair.attached = true;
         attached_.insert(key(i, j));
@@ -225,6 +236,7 @@ void DirectInteractions::execute(SphereSet& s, const Event& e) {
       }
       break;
     case Kind::well_edge:
+      if (!(radial_velocity > speed_floor)) break;
       if (reach_well_edge(s.velocity[i], s.velocity[j], n, du)) {
         pair.attached = false;
         attached_.erase(key(i, j));
@@ -265,6 +277,7 @@ void DirectInteractions::advance(SphereSet& s, const PeriodicBox& box, double dt
     throw std::invalid_argument("direct interactions: sphere arrays differ in length");
   local_time_.assign(n, 0.0);
   event_count_.assign(n, 0);
+  last_collision_.assign(n, -kNever);
   recent_.clear();
   if (n < 2) {
     for (int i = 0; i < n; ++i) s.position[i] = box.wrap(s.position[i] + s.velocity[i] * dt);

@@ -32,6 +32,11 @@ struct DirectInteractionParams {
   double friction = 0.0;         // mu_f >= 0
   double escape_velocity = 0.0;  // du (lattice units); 0: no square well at all
   double well_width = 0.15;      // delta (lattice units); SPEC default 0.025 a at a = 6
+  // TC model (Luding & McNamara 1998) against inelastic collapse: a collision
+  // of a sphere that already collided less than this time ago (within the
+  // same step) is elastic. Only matters for e < 1, where a cluster of touching
+  // spheres can otherwise need infinitely many collisions at one instant.
+  double contact_duration = 1e-6;  // lattice time units
   // A step that needs more events than this per sphere is stopped with a
   // diagnosis (EventCapExceeded) instead of hanging; realistic suspensions
   // need far below one event per sphere per step.
@@ -133,7 +138,8 @@ class DirectInteractions {
   std::vector<int> pairs_of_start_, pairs_of_;  // pairs of each sphere (CSR)
   std::vector<double> local_time_;              // time each sphere's position refers to
   std::vector<std::uint32_t> event_count_;
-  std::vector<Event> queue_;  // binary min-heap on time
+  std::vector<double> last_collision_;  // time of each sphere's last collision in this step
+  std::vector<Event> queue_;            // binary min-heap on time
   std::vector<Record> recent_;
   double speed_bound_ = 0.0;  // no sphere is faster while the pair list is valid
 };

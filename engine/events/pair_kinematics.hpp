@@ -19,33 +19,56 @@ using spheres::Vec3;
 
 inline constexpr double kNever = std::numeric_limits<double>::infinity();
 
-// Earliest time t >= 0 at which a closing pair (r.v < 0) reaches distance R
-// from outside; kNever when it separates or passes by. A closing pair already
-// at or inside R (touching, or overlapping by round-off) gives 0: it must be
-// resolved now, never be allowed to pass through.
-inline double time_to_close_to(const Vec3& r, const Vec3& v, double R) {
-  const double b = r.dot(v);
-  if (!(b < 0)) return kNever;
+// The radial relative velocity v.n, n = r/|r|, computed exactly as the event
+// rules compute it when they act. Whether a pair is closing or separating is
+// decided by this number alone, never by the sign of r.v (the two can differ
+// in round-off for a grazing pair).
+inline double radial_velocity(const Vec3& r, const Vec3& v) {
+  return v.dot(r / r.norm());
+}
+
+// Radial speeds below this fraction of the spheres' own speeds cannot be
+// changed in double precision: an impulse that small leaves both velocities
+// bit for bit as they were. A pair predicted to collide "now" at such a speed
+// would be predicted again after the collision, forever. Such pairs count as
+// neither closing nor separating; the overlap this allows is below
+// 1e-13 x speed x dt, i.e. round-off.
+inline constexpr double kResolvableSpeedFraction = 1e-13;
+inline double radial_speed_floor(const Vec3& u_i, const Vec3& u_j) {
+  return kResolvableSpeedFraction * (u_i.norm() + u_j.norm());
+}
+
+// Earliest time t >= 0 at which a pair closing faster than `floor` reaches
+// distance R from outside; kNever when it does not close or passes by. A
+// closing pair already at or inside R (touching, or overlapping by round-off)
+// gives 0: it must be resolved now, never be allowed to pass through.
+inline double time_to_close_to(const Vec3& r, const Vec3& v, double R, double floor) {
+  if (!(radial_velocity(r, v) < -floor)) return kNever;
   const double c = r.squaredNorm() - R * R;
   if (c <= 0) return 0.0;
   const double disc = v.squaredNorm() * R * R - r.cross(v).squaredNorm();
   if (!(disc > 0)) return kNever;
-  return c / (-b + std::sqrt(disc));
+  return c / (std::abs(r.dot(v)) + std::sqrt(disc));
 }
 
 // Time t >= 0 at which a pair inside distance R reaches it moving outward
-// (the far root); kNever when there is no relative motion. A pair found at or
-// just beyond R by round-off: if it is separating the crossing is now (0); if
-// it is closing it re-enters and leaves again after the chord, at -2b/vv.
-inline double time_to_open_to(const Vec3& r, const Vec3& v, double R) {
+// (the far root); kNever without relative motion. A separating pair found at
+// or just beyond R by round-off crosses now (0); a closing one re-enters and
+// leaves after the chord, 2|r.v|/v.v. A pair moving exactly tangentially at
+// the edge (radial speed below `floor`) has no chord: kNever.
+inline double time_to_open_to(const Vec3& r, const Vec3& v, double R, double floor) {
   const double vv = v.squaredNorm();
   if (!(vv > 0)) return kNever;
-  const double b = r.dot(v);
+  const double v_r = radial_velocity(r, v);
+  const double b = std::abs(r.dot(v));
   const double c = r.squaredNorm() - R * R;
-  if (c >= 0) return b < 0 ? -2.0 * b / vv : 0.0;
+  if (c >= 0) {
+    if (v_r > floor) return 0.0;
+    return v_r < -floor ? 2.0 * b / vv : kNever;
+  }
   const double disc = vv * R * R - r.cross(v).squaredNorm();
   const double root = std::sqrt(std::max(disc, b * b));  // disc >= b^2 exactly when c < 0
-  return b > 0 ? -c / (b + root) : (-b + root) / vv;
+  return v_r > floor ? -c / (b + root) : (b + root) / vv;
 }
 
 }  // namespace flocsim::events
