@@ -133,6 +133,15 @@ void FluidLattice<Real>::enable_force_field() {
 }
 
 template <class Real>
+void FluidLattice<Real>::clear_force_field() {
+  if (!has_force_field()) return;
+  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
+  std::memset(force_x_.get(), 0, cells * sizeof(Real));
+  std::memset(force_y_.get(), 0, cells * sizeof(Real));
+  std::memset(force_z_.get(), 0, cells * sizeof(Real));
+}
+
+template <class Real>
 Real* FluidLattice<Real>::force_field(int component) {
   return component == 0 ? force_x_.get() : component == 1 ? force_y_.get() : force_z_.get();
 }
@@ -177,6 +186,35 @@ Macroscopic FluidLattice<Real>::macroscopic(int x, int y, int z) const {
   m.density = 1.0 + drho;
   m.velocity = {(j[0] + 0.5 * F[0]) / m.density, (j[1] + 0.5 * F[1]) / m.density,
                 (j[2] + 0.5 * F[2]) / m.density};
+  return m;
+}
+
+template <class Real>
+Macroscopic FluidLattice<Real>::macroscopic_without_force_field(int x, int y, int z) const {
+  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
+  const long c = cell_index(x, y, z);
+  double f[kQ];
+  if (time_step_ % 2 == 0) {
+    for (int i = 0; i < kQ; ++i) f[i] = storage(i)[c];
+  } else if (x > 0 && x < nx - 1 && y > 0 && y < ny - 1 && z > 0 && z < nz - 1) {
+    const long plane = static_cast<long>(nx) * ny;
+    for (int i = 0; i < kQ; ++i)
+      f[i] = storage(opposite(i))[c - cx[i] - static_cast<long>(nx) * cy[i] - plane * cz[i]];
+  } else {
+    for (int i = 0; i < kQ; ++i)
+      f[i] = storage(opposite(i))[wrapped_index(x - cx[i], y - cy[i], z - cz[i])];
+  }
+  double drho = 0, jx = 0, jy = 0, jz = 0;
+  for (int i = 0; i < kQ; ++i) {
+    drho += f[i];
+    jx += cx[i] * f[i];
+    jy += cy[i] * f[i];
+    jz += cz[i] * f[i];
+  }
+  Macroscopic m;
+  m.density = 1.0 + drho;
+  m.velocity = {(jx + 0.5 * body_force_.x) / m.density, (jy + 0.5 * body_force_.y) / m.density,
+                (jz + 0.5 * body_force_.z) / m.density};
   return m;
 }
 

@@ -70,6 +70,8 @@ class FluidLattice {
   bool has_force_field() const { return force_x_ != nullptr; }
   Real* force_field(int component);  // 0, 1, 2 for x, y, z; index with cell_index
   const Real* force_field(int component) const;
+  // Sets the whole per-cell force field to zero (no-op when not enabled).
+  void clear_force_field();
 
   // ---- state ----------------------------------------------------------------
   // Sets every cell to the equilibrium of the given density and (physical,
@@ -81,6 +83,11 @@ class FluidLattice {
   // before collision: the AA pattern hides its storage slot.
   double population(int i, int x, int y, int z) const;
   Macroscopic macroscopic(int x, int y, int z) const;
+  // Density and velocity with the half-force shift of the uniform body force
+  // only, ignoring the per-cell force field: the velocity the liquid would have
+  // without the immersed-boundary force (direct forcing needs it). x, y, z must
+  // lie inside the box. Cheaper than macroscopic(): no modulo for interior cells.
+  Macroscopic macroscopic_without_force_field(int x, int y, int z) const;
 
   // Density and velocity of every cell (arrays of length cells(), x fastest).
   void macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,

@@ -1,0 +1,248 @@
+#include "engine/calibration/hydrodynamic_radius.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "engine/immersed_boundary/immersed_boundary.hpp"
+#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/spheres/sphere_set.hpp"
+
+namespace flocsim::calibration {
+
+namespace {
+constexpr std::array<double, 31> kSanganiAcrivos = {
+    1.000000,  1.418649,  2.012564,   2.331523,  2.564809, 2.584787, 2.873609, 3.340163,
+    3.536763,  3.504092,  3.253622,   2.689757,  2.037769, 1.809341, 1.877347, 1.534685,
+    0.9034708, 0.2857896, -0.5512626, -1.278724, 1.013350, 5.492491, 4.615388, -0.5736023,
+    -2.865924, -4.709215, -6.870076,  0.1455304, 12.51891, 9.742811, -5.566269};
+}  // namespace
+
+double sangani_acrivos_drag(double chi) {
+  if (!(chi >= 0.0 && chi < 1.0))
+    throw std::invalid_argument("Sangani-Acrivos drag: chi = " + std::to_string(chi) +
+                                ": must be in [0, 1)");
+  double k = 0, p = 1;
+  for (double q : kSanganiAcrivos) {
+    k += q * p;
+    p *= chi;
+  }
+  return k;
+}
+
+double hasimoto_drag(double chi) {
+  const double phi = M_PI / 6.0 * chi * chi * chi;
+  return 1.0 / (1.0 - 1.7601 * std::cbrt(phi) + phi - 1.5593 * phi * phi);
+}
+
+double ArrayDragResult::drag_coefficient(double a, double viscosity) const {
+  const double force = body_force * box * box * box;
+  return force / (6.0 * M_PI * viscosity * a * superficial_velocity);
+}
+
+double hydrodynamic_radius_from_drag(double force, double superficial_velocity, double viscosity,
+                                     int box) {
+  // g(a) = F / (6 pi nu a U) - K(2a/L) falls monotonically in a.
+  auto g = [&](double a) {
+    return force / (6.0 * M_PI * viscosity * a * superficial_velocity) -
+           sangani_acrivos_drag(2.0 * a / box);
+  };
+  double lo = 1e-3, hi = 0.4999 * box;
+  if (g(lo) < 0 || g(hi) > 0)
+    throw std::runtime_error(
+        "hydrodynamic radius: no radius in (0, L/2) matches the Sangani-Acrivos drag");
+  for (int i = 0; i < 200 && hi - lo > 1e-13 * box; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (g(mid) > 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
+                                        const ArrayDragSettings& settings) {
+  lattice::FluidLattice<double> fluid({box, box, box}, {settings.viscosity, 0.25});
+  immersed_boundary::ImmersedBoundary<double> ib(
+      {input_radius, settings.marker_spacing, settings.iterations, false});
+  spheres::SphereSet sphere;
+  sphere.radius = input_radius;
+  sphere.resize(1);
+  sphere.position[0] = spheres::Vec3::Constant(0.5 * box);
+  // Body force from the reference drag of a sphere of radius a_g, so that U
+  // comes out near the requested superficial velocity.
+  const double chi = std::min(0.95, 2.0 * input_radius / box);
+  const double body_force = 6.0 * M_PI * settings.viscosity * input_radius *
+                            sangani_acrivos_drag(chi) * settings.superficial_velocity /
+                            (static_cast<double>(box) * box * box);
+  fluid.set_body_force({body_force, 0, 0});
+  const double cells = static_cast<double>(box) * box * box;
+
+  ArrayDragResult r;
+  r.input_radius = input_radius;
+  r.box = box;
+  r.body_force = body_force;
+  constexpr int kCheck = 100;
+  double previous = 0;
+  int calm = 0;
+  long step = 0;
+  while (step < settings.max_steps) {
+    for (int s = 0; s < kCheck; ++s, ++step) {
+      ib.apply(fluid, sphere);
+      fluid.step();
+    }
+    const double u = fluid.total_momentum().x / fluid.total_mass();
+    if (!std::isfinite(u)) throw std::runtime_error("simple cubic array: velocity not finite");
+    calm = std::abs(u - previous) <= settings.tolerance * std::abs(u) ? calm + 1 : 0;
+    previous = u;
+    if (calm >= 3) break;
+  }
+  if (calm < 3)
+    throw std::runtime_error("simple cubic array (a_g = " + std::to_string(input_radius) +
+                             ", L = " + std::to_string(box) + "): no steady state within " +
+                             std::to_string(settings.max_steps) + " steps");
+  (void)cells;
+  r.superficial_velocity = previous;
+  r.ib_force = std::abs(ib.force()[0].x());
+  r.steps = step;
+  r.hydrodynamic_radius = hydrodynamic_radius_from_drag(body_force * cells, r.superficial_velocity,
+                                                        settings.viscosity, box);
+  return r;
+}
+
+CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::vector<int>& boxes,
+                                        const ArrayDragSettings& settings,
+                                        void (*progress)(const ArrayDragResult&)) {
+  if (boxes.empty()) throw std::invalid_argument("calibration: no box sizes given");
+  CalibrationEntry e;
+  e.hydrodynamic_radius = hydrodynamic_radius;
+  e.viscosity = settings.viscosity;
+  e.marker_spacing = settings.marker_spacing;
+  e.iterations = settings.iterations;
+  double ag = hydrodynamic_radius - 0.3;  // typical offset, refined below
+  for (int pass = 0; pass < 3; ++pass) {
+    e.checks.clear();
+    double mean_offset = 0;
+    for (int L : boxes) {
+      e.checks.push_back(simple_cubic_array_drag(ag, L, settings));
+      if (progress) progress(e.checks.back());
+      mean_offset += e.checks.back().hydrodynamic_radius - ag;
+    }
+    mean_offset /= static_cast<double>(boxes.size());
+    e.input_radius = ag;
+    const double miss = ag + mean_offset - hydrodynamic_radius;
+    if (pass > 0 && std::abs(miss) <= 0.01) break;
+    ag = hydrodynamic_radius - mean_offset;
+  }
+  return e;
+}
+
+namespace {
+nlohmann::json to_json(const ArrayDragResult& r, double viscosity) {
+  return {
+      {"box", r.box},
+      {"chi", 2.0 * r.hydrodynamic_radius / r.box},
+      {"body_force", r.body_force},
+      {"superficial_velocity", r.superficial_velocity},
+      {"steps", r.steps},
+      {"hydrodynamic_radius", r.hydrodynamic_radius},
+      {"K_with_input_radius", r.drag_coefficient(r.input_radius, viscosity)},
+      {"K_sangani_acrivos_at_input_radius", sangani_acrivos_drag(2.0 * r.input_radius / r.box)}};
+}
+}  // namespace
+
+void CalibrationTable::add(const CalibrationEntry& entry) {
+  std::erase_if(entries_, [&](const CalibrationEntry& e) {
+    return std::abs(e.hydrodynamic_radius - entry.hydrodynamic_radius) < 1e-6 &&
+           std::abs(e.viscosity - entry.viscosity) < 1e-9 &&
+           std::abs(e.marker_spacing - entry.marker_spacing) < 1e-9 &&
+           e.iterations == entry.iterations;
+  });
+  entries_.push_back(entry);
+  std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) {
+    return a.hydrodynamic_radius != b.hydrodynamic_radius
+               ? a.hydrodynamic_radius < b.hydrodynamic_radius
+               : a.viscosity < b.viscosity;
+  });
+}
+
+void CalibrationTable::save(const std::string& filename) const {
+  nlohmann::json j;
+  j["note"] = note;
+  j["entries"] = nlohmann::json::array();
+  for (const auto& e : entries_) {
+    nlohmann::json checks = nlohmann::json::array();
+    for (const auto& c : e.checks) checks.push_back(to_json(c, e.viscosity));
+    j["entries"].push_back({{"hydrodynamic_radius", e.hydrodynamic_radius},
+                            {"viscosity", e.viscosity},
+                            {"input_radius", e.input_radius},
+                            {"marker_spacing", e.marker_spacing},
+                            {"iterations", e.iterations},
+                            {"checks", checks}});
+  }
+  std::ofstream out(filename);
+  if (!out) throw std::runtime_error("cannot write calibration table " + filename);
+  out << j.dump(2) << "\n";
+  if (!out) throw std::runtime_error("error writing calibration table " + filename);
+}
+
+CalibrationTable CalibrationTable::load(const std::string& filename) {
+  std::ifstream in(filename);
+  if (!in) throw std::runtime_error("cannot read calibration table " + filename);
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("calibration table " + filename + ": " + e.what());
+  }
+  CalibrationTable t;
+  t.note = j.value("note", "");
+  for (const auto& je : j.at("entries")) {
+    CalibrationEntry e;
+    e.hydrodynamic_radius = je.at("hydrodynamic_radius").get<double>();
+    e.viscosity = je.at("viscosity").get<double>();
+    e.input_radius = je.at("input_radius").get<double>();
+    e.marker_spacing = je.at("marker_spacing").get<double>();
+    e.iterations = je.at("iterations").get<int>();
+    for (const auto& jc : je.value("checks", nlohmann::json::array())) {
+      ArrayDragResult r;
+      r.input_radius = e.input_radius;
+      r.box = jc.at("box").get<int>();
+      r.body_force = jc.at("body_force").get<double>();
+      r.superficial_velocity = jc.at("superficial_velocity").get<double>();
+      r.steps = jc.at("steps").get<long>();
+      r.hydrodynamic_radius = jc.at("hydrodynamic_radius").get<double>();
+      e.checks.push_back(r);
+    }
+    t.entries_.push_back(e);
+  }
+  return t;
+}
+
+const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, double viscosity,
+                                                 double marker_spacing, int iterations) const {
+  const CalibrationEntry* best = nullptr;
+  for (const auto& e : entries_) {
+    if (std::abs(e.hydrodynamic_radius - hydrodynamic_radius) > 1e-6) continue;
+    if (std::abs(e.marker_spacing - marker_spacing) > 1e-9 || e.iterations != iterations) continue;
+    if (!best || std::abs(std::log(e.viscosity / viscosity)) <
+                     std::abs(std::log(best->viscosity / viscosity)))
+      best = &e;
+  }
+  if (!best) {
+    std::ostringstream msg;
+    msg << "no hydrodynamic-radius calibration for a = " << hydrodynamic_radius
+        << " dx (marker spacing " << marker_spacing << ", " << iterations
+        << " iterations); calibrated:";
+    for (const auto& e : entries_)
+      msg << " a = " << e.hydrodynamic_radius << " (nu = " << e.viscosity << ", spacing "
+          << e.marker_spacing << ", " << e.iterations << " it)";
+    msg << ". Run `flocsim calibrate`.";
+    throw std::out_of_range(msg.str());
+  }
+  return *best;
+}
+
+}  // namespace flocsim::calibration

@@ -1,0 +1,97 @@
+#pragma once
+// Hydrodynamic radius of immersed-boundary spheres.
+//
+// Markers on a sphere of input radius a_g do not produce exactly the drag of
+// a sphere of radius a_g: the kernel smears the surface over about 1.5 dx and
+// the liquid inside moves with the surface. The effective (hydrodynamic)
+// radius a is measured once per (a_g, viscosity, immersed-boundary settings):
+// one fixed sphere in a periodic cube of edge L (a simple cubic array,
+// chi = 2a/L) is driven by a small body force f until the creeping flow is
+// steady; the drag coefficient K = F / (6 pi rho nu a U), with F = f L^3 and U
+// the superficial velocity (lattice momentum / lattice mass), must then equal
+// the Sangani & Acrivos (1982) value K(chi). That equation has one root in a,
+// the hydrodynamic radius seen in that box. The calibration averages it over
+// several chi and inverts a(a_g) so that the solver can ask for the input
+// radius that gives a wanted hydrodynamic radius.
+#include <string>
+#include <vector>
+
+namespace flocsim::calibration {
+
+// Sangani & Acrivos (1982) eq. 60, 31-term series in chi = 2a/L, for the
+// Stokes drag of a simple cubic array, K = F / (6 pi mu a U). Valid for
+// 0 <= chi < 1 (touching spheres at chi = 1).
+double sangani_acrivos_drag(double chi);
+
+// Hasimoto (1959) small-concentration form of the same: 1/K = 1 -
+// 1.7601 phi^(1/3) + phi - 1.5593 phi^2, phi = (pi/6) chi^3.
+double hasimoto_drag(double chi);
+
+struct ArrayDragSettings {
+  double viscosity = 1.0 / 6.0;  // lattice viscosity of the calibration runs
+  double marker_spacing = 0.7;
+  int iterations = 2;
+  double superficial_velocity = 1e-4;  // sets the body force through the reference K; Re << 1
+  double tolerance = 1e-6;             // relative change of U per 100 steps at steady state
+  long max_steps = 400000;
+};
+
+struct ArrayDragResult {
+  double input_radius = 0;
+  int box = 0;                      // L
+  double body_force = 0;            // f
+  double superficial_velocity = 0;  // U
+  double ib_force = 0;              // |H_x| on the sphere at the end (equals f L^3 when steady)
+  long steps = 0;
+  double hydrodynamic_radius = 0;  // root of K_measured(a) = K_SA(2a/L)
+  // K for a given radius a: F / (6 pi nu a U).
+  double drag_coefficient(double a, double viscosity) const;
+};
+
+// One fixed sphere of input radius a_g centred in a periodic cube of edge L,
+// creeping flow driven along x, run to a steady state (double precision).
+ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
+                                        const ArrayDragSettings& settings);
+
+// The radius a for which F / (6 pi nu a U) = K_SA(2a/L).
+double hydrodynamic_radius_from_drag(double force, double superficial_velocity, double viscosity,
+                                     int box);
+
+// One calibrated resolution: input radius that gives hydrodynamic radius a.
+struct CalibrationEntry {
+  double hydrodynamic_radius = 0;  // a (dx)
+  double viscosity = 0;
+  double input_radius = 0;  // a_g (dx)
+  double marker_spacing = 0.7;
+  int iterations = 2;
+  std::vector<ArrayDragResult> checks;  // the runs with the final a_g
+};
+
+// Finds a_g for the wanted a: runs the boxes with a first guess, shifts a_g by
+// the mean offset a - a_g measured, runs again, and repeats the shift once
+// more when the boxes disagree with the wanted a by more than 0.01 dx.
+// `progress` (may be empty) receives one line per run.
+CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::vector<int>& boxes,
+                                        const ArrayDragSettings& settings,
+                                        void (*progress)(const ArrayDragResult&) = nullptr);
+
+// The table the solver reads (JSON): entries by (a, nu).
+class CalibrationTable {
+ public:
+  static CalibrationTable load(const std::string& filename);
+  void save(const std::string& filename) const;
+  void add(const CalibrationEntry& entry);
+  const std::vector<CalibrationEntry>& entries() const { return entries_; }
+  // The input radius for hydrodynamic radius a at viscosity nu: the entry with
+  // the same a (within 1e-6 dx), marker spacing and iterations whose viscosity
+  // is nearest to nu. Throws std::out_of_range, naming what exists, when no
+  // entry has that a.
+  const CalibrationEntry& lookup(double hydrodynamic_radius, double viscosity,
+                                 double marker_spacing = 0.7, int iterations = 2) const;
+  std::string note;  // how the table was made
+
+ private:
+  std::vector<CalibrationEntry> entries_;
+};
+
+}  // namespace flocsim::calibration

@@ -1,0 +1,47 @@
+#pragma once
+// The interpolation/spreading kernel of the immersed boundary: the 3-point
+// kernel of Roma, Peskin & Berger (1999), support |r| < 1.5 dx.
+//
+// phi(r) = (1 + sqrt(1 - 3 r^2)) / 3                      |r| <= 1/2
+//        = (5 - 3|r| - sqrt(1 - 3 (1 - |r|)^2)) / 6        1/2 <= |r| <= 3/2
+//        = 0                                              otherwise
+//
+// It satisfies sum_i phi(x - i) = 1 and sum_i (x - i) phi(x - i) = 0 for every
+// x, so spreading conserves the total force exactly and its first moment
+// (torque about a marker) to round-off, and interpolation reproduces linear
+// fields exactly. Three points per direction (27 cells per marker) is the
+// narrowest smooth kernel with these properties; the 4-point Peskin kernel
+// costs 64 cells per marker for the same moments.
+#include <cmath>
+
+namespace flocsim::immersed_boundary {
+
+inline double roma_kernel(double r) {
+  r = std::abs(r);
+  if (r <= 0.5) return (1.0 + std::sqrt(1.0 - 3.0 * r * r)) / 3.0;
+  if (r <= 1.5) {
+    const double s = 1.0 - r;
+    return (5.0 - 3.0 * r - std::sqrt(std::max(0.0, 1.0 - 3.0 * s * s))) / 6.0;
+  }
+  return 0.0;
+}
+
+// The three weights of one direction for a marker at coordinate x: cells
+// first, first + 1, first + 2, with first = round(x) - 1.
+struct KernelWeights {
+  int first;
+  double w[3];
+};
+
+inline KernelWeights kernel_weights(double x) {
+  KernelWeights k;
+  const double nearest = std::nearbyint(x);
+  k.first = static_cast<int>(nearest) - 1;
+  const double d = x - nearest;  // in [-1/2, 1/2]
+  k.w[0] = roma_kernel(d + 1.0);
+  k.w[1] = roma_kernel(d);
+  k.w[2] = roma_kernel(d - 1.0);
+  return k;
+}
+
+}  // namespace flocsim::immersed_boundary

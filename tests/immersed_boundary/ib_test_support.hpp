@@ -1,0 +1,19 @@
+#pragma once
+// Shared set-up of the immersed-boundary physics tests.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "engine/calibration/hydrodynamic_radius.hpp"
+
+namespace flocsim::test {
+
+// Input radius for hydrodynamic radius a from the shipped calibration table
+// (engine/calibration/hydrodynamic_radius.json), nearest calibrated viscosity.
+inline double calibrated_input_radius(double a, double viscosity) {
+  static const calibration::CalibrationTable table =
+      calibration::CalibrationTable::load(FLOCSIM_CALIBRATION_TABLE);
+  return table.lookup(a, viscosity).input_radius;
+}
+
+}  // namespace flocsim::test
