@@ -1,0 +1,223 @@
+// flocsim sweep launch|resume|status|cancel: run a parameter grid through the
+// results database (docs/orchestrator.md).
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+
+#include "apps/flocsim/command_registry.hpp"
+#include "db/results_db.hpp"
+#include "engine/input/input_reader.hpp"
+#include "orchestrator/local_pool.hpp"
+#include "orchestrator/process.hpp"
+#include "orchestrator/report.hpp"
+#include "orchestrator/slurm_backend.hpp"
+#include "orchestrator/sweep.hpp"
+
+namespace flocsim::app {
+namespace {
+
+namespace orc = flocsim::orchestrator;
+
+struct SweepOptions {
+  std::string sweep_file, db_path, runs_dir, backend = "local", worker, sweep_name;
+  int jobs = 1;
+  double lease_s = 60;
+  double grace_s = 120;
+  bool no_wait = false;
+  // slurm-task (internal)
+  std::string task_file;
+};
+
+std::string default_worker() {
+  if (const char* env = std::getenv("FLOCSIM_WORKER"); env && *env) return env;
+  std::error_code ec;
+  auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) return self.string();
+  throw flocsim::input::InputError(
+      "cannot find the flocsim executable to run as the worker; give --worker PATH");
+}
+
+int exit_code_for(db::ResultsDb& db, const db::SweepRecord& sweep, bool stopped) {
+  if (stopped) return kExitInterrupted;
+  for (const db::StateCount& c : db.count_states(sweep.id))
+    if (c.status != "completed" && c.runs > 0) return kExitFailure;
+  return kExitOk;
+}
+
+void print_summary(const orc::PoolSummary& s, db::ResultsDb& db, const db::SweepRecord& sweep) {
+  std::cout << "this session: started " << s.started << ", completed " << s.completed
+            << ", recovered " << s.recovered << ", failed " << s.failed << ", refused " << s.refused
+            << ", interrupted " << s.interrupted << ", lost " << s.lost << "\n";
+  orc::write_status(db, sweep.name, std::cout);
+  bool restartable = false;
+  for (const db::StateCount& c : db.count_states(sweep.id))
+    if ((c.status == "failed" || c.status == "lost" || c.status == "interrupted") && c.runs > 0)
+      restartable = true;
+  if (restartable)
+    std::cout << "restart what did not finish with: flocsim sweep resume --db " << db.path()
+              << " --sweep " << sweep.name << "\n";
+}
+
+db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
+  if (!name.empty()) {
+    auto s = db.find_sweep(name);
+    if (!s) throw flocsim::input::InputError("--sweep " + name + ": no such sweep in " + db.path());
+    return *s;
+  }
+  auto all = db.sweeps();
+  if (all.size() == 1) return all.front();
+  std::string known;
+  for (const auto& s : all) known += (known.empty() ? "" : ", ") + s.name;
+  throw flocsim::input::InputError(db.path() + " holds " + std::to_string(all.size()) +
+                                   " sweeps; choose one with --sweep (" +
+                                   (known.empty() ? "none" : known) + ")");
+}
+
+int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
+              std::vector<std::string> states) {
+  if (o.backend == "slurm") {
+    orc::SlurmLaunch launch;
+    launch.worker = o.worker.empty() ? default_worker() : o.worker;
+    launch.flocsim = default_worker();
+    if (std::getenv("FLOCSIM_SWEEP_EXE")) launch.flocsim = std::getenv("FLOCSIM_SWEEP_EXE");
+    launch.states = states;
+    launch.lease_s = o.lease_s;
+    launch.wait = !o.no_wait;
+    launch.out = &std::cout;
+    orc::install_stop_handlers();
+    const orc::SlurmSummary s = orc::run_slurm(db, sweep, launch);
+    if (!launch.wait) return kExitOk;
+    orc::write_status(db, sweep.name, std::cout);
+    return exit_code_for(db, sweep, s.stopped);
+  }
+  orc::PoolOptions p;
+  p.worker = o.worker.empty() ? default_worker() : o.worker;
+  p.jobs = o.jobs;
+  p.states = std::move(states);
+  p.lease_s = o.lease_s;
+  p.grace_s = o.grace_s;
+  p.out = &std::cout;
+  orc::install_stop_handlers();
+  const orc::PoolSummary s = orc::run_pool(db, sweep, p);
+  print_summary(s, db, sweep);
+  return exit_code_for(db, sweep, s.stopped);
+}
+
+void common_run_options(CLI::App& cmd, SweepOptions& o) {
+  cmd.add_option("--jobs,-j", o.jobs, "Worker processes at once (local backend)")
+      ->check(CLI::Range(1, 4096));
+  cmd.add_option("--backend", o.backend, "Where workers run")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  cmd.add_option("--lease", o.lease_s,
+                 "Seconds without a heartbeat (progress.json) after which a worker is lost")
+      ->check(CLI::Range(5.0, 1e6));
+  cmd.add_option("--grace", o.grace_s,
+                 "Seconds a stopping worker may take to write its checkpoint before it is killed")
+      ->check(CLI::Range(1.0, 1e6));
+  cmd.add_option("--worker", o.worker,
+                 "Program run as `WORKER run CASE --out DIR` (default: this flocsim, or "
+                 "$FLOCSIM_WORKER)");
+  cmd.add_flag("--no-wait", o.no_wait, "Slurm: submit and return without following the jobs");
+}
+
+const bool registered = register_command(
+    {"sweep", "Launch, resume, follow or cancel a parameter sweep", [](CLI::App& cmd) {
+       auto o = std::make_shared<SweepOptions>();
+       auto action = std::make_shared<std::string>();
+       cmd.require_subcommand(1);
+
+       CLI::App* launch = cmd.add_subcommand(
+           "launch", "Expand SWEEP.json into runs, record them in the database and run them");
+       launch->add_option("sweep", o->sweep_file, "Sweep file (JSON)")->required();
+       launch->add_option("--db", o->db_path, "Results database (created when missing)")
+           ->required();
+       launch->add_option("--runs-dir", o->runs_dir,
+                          "Folder of the run directories (default: DB name with .runs)");
+       common_run_options(*launch, *o);
+       launch->callback([action] { *action = "launch"; });
+
+       CLI::App* resume = cmd.add_subcommand(
+           "resume", "Restart failed, lost and interrupted runs (from their checkpoints)");
+       resume->add_option("--db", o->db_path, "Results database")->required();
+       resume->add_option("--sweep", o->sweep_name,
+                          "Sweep name (needed when the database has several)");
+       common_run_options(*resume, *o);
+       resume->callback([action] { *action = "resume"; });
+
+       CLI::App* status = cmd.add_subcommand("status", "Runs by state, progress, ETA, failures");
+       status->add_option("--db", o->db_path, "Results database")->required();
+       status->add_option("--sweep", o->sweep_name, "Only this sweep");
+       status->add_option("--lease", o->lease_s, "Heartbeat lease for remote workers (s)");
+       status->callback([action] { *action = "status"; });
+
+       CLI::App* cancel = cmd.add_subcommand(
+           "cancel", "Stop the running orchestrators and Slurm jobs of the database gracefully");
+       cancel->add_option("--db", o->db_path, "Results database")->required();
+       cancel->callback([action] { *action = "cancel"; });
+
+       CLI::App* task = cmd.add_subcommand("slurm-task", "Internal: one Slurm array task");
+       task->group("");  // hidden from --help
+       task->add_option("--db", o->db_path)->required();
+       task->add_option("--sweep", o->sweep_name)->required();
+       task->add_option("--task-file", o->task_file)->required();
+       task->add_option("--worker", o->worker)->required();
+       task->add_option("--lease", o->lease_s);
+       task->callback([action] { *action = "slurm-task"; });
+
+       return CommandHandler([o, action]() -> int {
+         try {
+           if (*action == "launch") {
+             const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
+             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
+             orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
+             const std::string runs_dir =
+                 o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
+             const orc::Registered reg = orc::register_sweep(db, spec, runs_dir);
+             std::cout << "sweep " << spec.name << ": " << reg.runs << " runs (" << reg.added.added
+                       << " new, " << reg.added.reused << " already in " << o->db_path
+                       << "); run folders under " << std::filesystem::absolute(runs_dir).string()
+                       << "\n";
+             return run_sweep(*o, db, reg.sweep, {"pending", "interrupted", "lost"});
+           }
+           if (*action == "resume") {
+             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+             orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
+             const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
+             return run_sweep(*o, db, sweep, {"pending", "interrupted", "lost", "failed"});
+           }
+           if (*action == "status") {
+             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+             orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
+             orc::write_status(
+                 db,
+                 o->sweep_name.empty() ? std::nullopt : std::optional<std::string>(o->sweep_name),
+                 std::cout);
+             return kExitOk;
+           }
+           if (*action == "cancel") {
+             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+             return orc::cancel_all(db, std::cout) >= 0 ? kExitOk : kExitFailure;
+           }
+           if (*action == "slurm-task") {
+             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+             const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
+             orc::install_stop_handlers();
+             return orc::run_slurm_task(db, sweep, o->task_file, o->worker, o->lease_s, std::cout);
+           }
+         } catch (const flocsim::input::InputError& e) {
+           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           return kExitBadInput;
+         } catch (const db::DbError& e) {
+           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           return kExitFailure;
+         }
+         return kExitBadInput;
+       });
+     }});
+
+}  // namespace
+}  // namespace flocsim::app

@@ -1,0 +1,409 @@
+#include "orchestrator/local_pool.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "orchestrator/process.hpp"
+
+namespace flocsim::orchestrator {
+
+namespace fs = std::filesystem;
+using db::unix_now;
+
+std::atomic<int> g_stop_requests{0};
+
+namespace {
+void on_stop_signal(int) {
+  g_stop_requests.fetch_add(1);
+}
+}  // namespace
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+std::string default_runs_dir(const std::string& db_path) {
+  fs::path p = fs::absolute(db_path);
+  p.replace_extension(".runs");
+  return p.string();
+}
+
+Registered register_sweep(db::ResultsDb& db, const SweepSpec& spec, const std::string& runs_dir) {
+  const std::vector<RunPoint> points = expand(spec);
+  nlohmann::json axes = nlohmann::json::array();
+  for (const Axis& a : spec.axes) axes.push_back(a.path);
+  const fs::path dir = fs::absolute(runs_dir);
+  std::vector<db::ResultsDb::NewRun> runs;
+  for (const RunPoint& p : points)
+    runs.push_back({p.id, p.case_json.dump(), (dir / p.id.substr(0, 16)).string(), p.point.dump()});
+  Registered r;
+  const std::int64_t id =
+      db.upsert_sweep(spec.name, spec.source.dump(), axes.dump(), spec.max_attempts);
+  r.added = db.add_runs(id, runs);
+  r.runs = static_cast<int>(runs.size());
+  r.sweep = *db.find_sweep(spec.name);
+  return r;
+}
+
+namespace {
+
+std::string short_id(const std::string& id) {
+  return id.substr(0, 12);
+}
+
+std::string point_text(const std::string& point_json) {
+  if (point_json.empty()) return "";
+  const auto p = nlohmann::ordered_json::parse(point_json, nullptr, false);
+  if (!p.is_object()) return point_json;
+  std::string out;
+  for (auto it = p.begin(); it != p.end(); ++it)
+    out += (out.empty() ? "" : " ") + it.key() + "=" +
+           (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
+  return out;
+}
+
+void say(std::ostream* out, const std::string& line) {
+  if (out) *out << line << std::endl;
+}
+
+// Records a result found complete on disk; returns whether it was valid.
+bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::RunRecord& run) {
+  ResultRead rr = read_result(run.run_dir, run.id);
+  if (!rr.record) return false;
+  db.record_result(attempt_id, *rr.record);
+  return true;
+}
+
+struct Orphan {
+  db::AttemptRecord attempt;
+  db::RunRecord run;
+};
+
+std::vector<Orphan> reconcile(db::ResultsDb& db, double lease_s, std::ostream* out, int* closed) {
+  const std::string host = host_name();
+  const pid_t self = getpid();
+  const double now = unix_now();
+  std::vector<Orphan> orphans;
+  for (const db::AttemptRecord& a : db.live_attempts()) {
+    if (a.owner_pid == self) continue;
+    const auto run = db.find_run(a.run_id);
+    if (!run) continue;
+    if (a.host == host) {
+      if (process_alive(static_cast<pid_t>(a.owner_pid))) continue;  // watched by its owner
+      if (a.pid > 0 && process_alive(static_cast<pid_t>(a.pid), a.pid_start)) {
+        orphans.push_back({a, *run});
+        continue;
+      }
+      if (record_if_complete(db, a.id, *run)) {
+        say(out, "recorded   " + short_id(a.run_id) +
+                     ": finished while its orchestrator was gone (result.json complete)");
+      } else {
+        const std::string why =
+            "worker " + (a.pid > 0 ? "pid " + std::to_string(a.pid) : "(not started)") + " on " +
+            host + " is gone and its orchestrator (pid " + std::to_string(a.owner_pid) + ") died";
+        if (db.end_attempt(a.id, "lost", std::nullopt, std::nullopt, why))
+          say(out, "lost       " + short_id(a.run_id) + ": " + why);
+      }
+      if (closed) ++*closed;
+    } else {
+      const double beat = a.heartbeat_at.value_or(a.started_at);
+      if (now - beat <= lease_s) continue;
+      if (record_if_complete(db, a.id, *run)) {
+        say(out, "recorded   " + short_id(a.run_id) + ": finished on " + a.host);
+      } else {
+        char why[256];
+        std::snprintf(why, sizeof why, "no heartbeat from %s (pid %lld) for %.0f s (lease %.0f s)",
+                      a.host.c_str(), static_cast<long long>(a.pid), now - beat, lease_s);
+        if (db.end_attempt(a.id, "lost", std::nullopt, std::nullopt, why))
+          say(out, "lost       " + short_id(a.run_id) + ": " + why);
+      }
+      if (closed) ++*closed;
+    }
+  }
+  return orphans;
+}
+
+struct Worker {
+  pid_t pid = 0;
+  bool child = true;  // our child (waitpid) or adopted from a dead orchestrator
+  std::string pid_start;
+  std::int64_t attempt_id = 0;
+  db::RunRecord run;
+  double started = 0, last_beat = 0;
+  double term_sent = 0;
+  bool kill_sent = false;
+  bool lease_expired = false;
+};
+
+void write_case_file(const std::string& run_dir, const std::string& case_json) {
+  const fs::path dir(run_dir);
+  const fs::path tmp = dir / "case.json.tmp";
+  {
+    std::ofstream f(tmp);
+    f << nlohmann::json::parse(case_json).dump(2) << "\n";
+    f.flush();
+    if (!f) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, dir / "case.json");
+}
+
+}  // namespace
+
+int reconcile_lost_workers(db::ResultsDb& db, double lease_s, std::ostream* out) {
+  int closed = 0;
+  reconcile(db, lease_s, out, &closed);
+  return closed;
+}
+
+PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const PoolOptions& o) {
+  PoolSummary sum;
+  if (o.jobs < 1) throw std::invalid_argument("--jobs must be at least 1");
+  const std::string host = host_name();
+  const pid_t self = getpid();
+  std::vector<Worker> workers;
+
+  // Runs of this sweep that a dead orchestrator left running: watch them to the end.
+  std::set<std::string> in_sweep;
+  for (const db::RunRecord& r : db.runs(sweep.id)) in_sweep.insert(r.id);
+  for (Orphan& orphan : reconcile(db, o.lease_s, o.out, nullptr)) {
+    if (!in_sweep.count(orphan.run.id)) continue;
+    if (!db.adopt_attempt(orphan.attempt.id, self)) continue;
+    Worker w;
+    w.pid = static_cast<pid_t>(orphan.attempt.pid);
+    w.child = false;
+    w.pid_start = orphan.attempt.pid_start;
+    w.attempt_id = orphan.attempt.id;
+    w.run = orphan.run;
+    w.started = orphan.attempt.started_at;
+    w.last_beat = std::max(unix_now(), orphan.attempt.heartbeat_at.value_or(0));
+    say(o.out, "adopted    " + short_id(w.run.id) + ": worker pid " + std::to_string(w.pid) +
+                   " still running from an earlier orchestrator");
+    workers.push_back(std::move(w));
+  }
+
+  std::vector<std::string> only;
+  if (o.only_runs) only = *o.only_runs;
+  std::size_t only_next = 0;
+  std::vector<std::string> tried;
+  const int total = static_cast<int>(in_sweep.size());
+  auto progress_tag = [&] {
+    const auto counts = db.count_states(sweep.id);
+    int done = 0;
+    for (const auto& c : counts)
+      if (c.status == "completed") done = c.runs;
+    return "[" + std::to_string(done) + "/" + std::to_string(total) + "]";
+  };
+
+  // Claims and starts one run; false when nothing is claimable.
+  auto start_one = [&]() -> bool {
+    while (true) {
+      // One attempt per run per pool: a run that fails or is lost here waits
+      // for the next launch or resume (no tight retry loops).
+      db::ClaimRequest req{sweep.id, o.states, sweep.max_attempts, std::nullopt, tried};
+      if (o.only_runs) {
+        if (only_next >= only.size()) return false;
+        req.run_id = only[only_next++];
+      }
+      db::AttemptStart start;
+      start.backend = o.backend;
+      start.host = host;
+      start.owner_pid = self;
+      start.job_id = o.job_id;
+      const std::optional<db::Claim> claim = db.claim_run(req, start);
+      if (!claim) {
+        if (o.only_runs) continue;  // that run is not claimable (done, or taken): next one
+        return false;
+      }
+      const db::RunRecord& run = claim->run;
+      tried.push_back(run.id);
+      fs::create_directories(run.run_dir);
+      // A complete result already on disk (its recording was cut short): record, don't rerun.
+      if (record_if_complete(db, claim->attempt_id, run)) {
+        ++sum.recovered;
+        say(o.out, progress_tag() + " recorded " + short_id(run.id) + " " +
+                       point_text(run.point_json) + " (result.json found complete on disk)");
+        continue;
+      }
+      const bool resume = run.status != "pending";
+      try {
+        write_case_file(run.run_dir, run.case_json);
+        std::vector<std::string> argv{o.worker, "run", run.run_dir + "/case.json", "--out",
+                                      run.run_dir};
+        if (resume) argv.push_back("--resume");
+        argv.push_back("--quiet");
+        Worker w;
+        w.pid = spawn(argv, run.run_dir + "/worker.log");
+        w.pid_start = process_start_time(w.pid);
+        w.attempt_id = claim->attempt_id;
+        w.run = run;
+        w.started = unix_now();
+        w.last_beat = w.started;
+        db.set_attempt_pid(w.attempt_id, w.pid, w.pid_start, run.run_dir + "/run.log");
+        ++sum.started;
+        say(o.out, progress_tag() + " started  " + short_id(run.id) + " " +
+                       point_text(run.point_json) + (resume ? " (resuming)" : "") + " pid " +
+                       std::to_string(w.pid));
+        workers.push_back(std::move(w));
+      } catch (const std::exception& e) {
+        db.end_attempt(claim->attempt_id, "failed", std::nullopt, std::nullopt,
+                       std::string("could not start the worker: ") + e.what());
+        ++sum.failed;
+        say(o.out, "failed   " + short_id(run.id) + ": could not start the worker: " + e.what());
+      }
+      return true;
+    }
+  };
+
+  // Records how a worker ended.
+  auto finish = [&](const Worker& w, std::optional<int> exit_code, std::optional<int> sig) {
+    const std::string tag = short_id(w.run.id) + " " + point_text(w.run.point_json);
+    ResultRead rr = read_result(w.run.run_dir, w.run.id);
+    if (rr.record) {
+      db.record_result(w.attempt_id, *rr.record);
+      ++sum.completed;
+      char secs[32];
+      std::snprintf(secs, sizeof secs, "%.1f", unix_now() - w.started);
+      say(o.out, progress_tag() + " done     " + tag + " in " + secs + " s");
+      return;
+    }
+    const std::string tail = tail_of_file(w.run.run_dir + "/worker.log");
+    std::string state, why;
+    if (w.lease_expired) {
+      state = "lost";
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "no heartbeat (progress.json) for more than %.0f s; worker stopped", o.lease_s);
+      why = buf;
+    } else if (exit_code) {
+      switch (*exit_code) {
+        case 0:
+          state = "failed";
+          why = "worker exited 0 but its result is not usable: " + rr.problem;
+          break;
+        case 2:
+          state = "refused";
+          why = "case refused (exit 2): " + tail;
+          break;
+        case 3:
+          state = "interrupted";
+          why = "stopped by a signal after writing a checkpoint (exit 3)";
+          break;
+        default:
+          state = "failed";
+          why = "exit code " + std::to_string(*exit_code) + ": " + tail;
+      }
+    } else if (sig) {
+      const bool external = *sig == SIGKILL || *sig == SIGTERM || *sig == SIGINT || *sig == SIGHUP;
+      state = external ? "lost" : "failed";
+      why = "worker killed by " + signal_name(*sig) + (tail.empty() ? "" : ": " + tail);
+    } else {
+      state = "lost";
+      why = "worker pid " + std::to_string(w.pid) +
+            " ended unwatched (its orchestrator had died) without a result";
+    }
+    db.end_attempt(w.attempt_id, state, exit_code, sig, why);
+    if (state == "failed") ++sum.failed;
+    if (state == "refused") ++sum.refused;
+    if (state == "interrupted") ++sum.interrupted;
+    if (state == "lost") ++sum.lost;
+    const std::string first_line = why.substr(0, why.find('\n'));
+    say(o.out, progress_tag() + " " + state +
+                   (state.size() < 8 ? std::string(8 - state.size(), ' ') : "") + " " + tag + ": " +
+                   first_line);
+  };
+
+  double last_heartbeat_write = 0;
+  double stop_seen = 0;
+  while (true) {
+    const int stops = g_stop_requests.load();
+    const double now = unix_now();
+    if (stops > 0 && stop_seen == 0) {
+      stop_seen = now;
+      sum.stopped = true;
+      say(o.out, "stopping: asking " + std::to_string(workers.size()) +
+                     " worker(s) to checkpoint and exit (signal again to kill them)");
+    }
+    bool exhausted = false;
+    if (stops == 0) {
+      while (static_cast<int>(workers.size()) < o.jobs) {
+        if (!start_one()) {
+          exhausted = true;
+          break;
+        }
+      }
+    }
+    // Reap and watch.
+    for (std::size_t i = 0; i < workers.size();) {
+      Worker& w = workers[i];
+      bool ended = false;
+      std::optional<int> code, sig;
+      if (w.child) {
+        int status = 0;
+        const pid_t r = waitpid(w.pid, &status, WNOHANG);
+        if (r == w.pid) {
+          ended = true;
+          if (WIFEXITED(status)) code = WEXITSTATUS(status);
+          if (WIFSIGNALED(status)) sig = WTERMSIG(status);
+        }
+      } else if (!process_alive(w.pid, w.pid_start)) {
+        ended = true;
+      }
+      if (ended) {
+        finish(w, code, sig);
+        workers.erase(workers.begin() + static_cast<std::ptrdiff_t>(i));
+        continue;
+      }
+      // Stop requests and expired leases.
+      if (stop_seen > 0 && w.term_sent == 0) {
+        kill(w.pid, SIGTERM);
+        w.term_sent = now;
+      }
+      if (!w.kill_sent && w.term_sent > 0 &&
+          (stops >= 2 || now - w.term_sent > (w.lease_expired ? 10.0 : o.grace_s))) {
+        kill(w.pid, SIGKILL);
+        w.kill_sent = true;
+      }
+      if (!w.lease_expired && now - w.last_beat > o.lease_s) {
+        w.lease_expired = true;
+        if (w.term_sent == 0) {
+          kill(w.pid, SIGTERM);
+          w.term_sent = now;
+        }
+      }
+      ++i;
+    }
+    // Heartbeats into the database, at most every 2 s, in one short transaction.
+    if (now - last_heartbeat_write >= 2.0) {
+      std::vector<db::Heartbeat> beats;
+      for (Worker& w : workers) {
+        auto hb = read_progress(w.run.run_dir);
+        if (!hb || hb->at < w.started) continue;  // progress.json of an earlier attempt
+        w.last_beat = std::max(w.last_beat, hb->at);
+        hb->attempt_id = w.attempt_id;
+        beats.push_back(*hb);
+      }
+      db.record_heartbeats(beats);
+      last_heartbeat_write = now;
+    }
+    if (workers.empty() && (stops > 0 || exhausted)) break;
+    std::this_thread::sleep_for(std::chrono::duration<double>(o.poll_s));
+  }
+  return sum;
+}
+
+}  // namespace flocsim::orchestrator

@@ -1,0 +1,366 @@
+#include "orchestrator/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "engine/input/input_reader.hpp"
+#include "orchestrator/sweep.hpp"
+
+namespace flocsim::orchestrator {
+
+using flocsim::input::InputError;
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+Filter parse_filter(const std::string& text) {
+  static const char* ops[] = {"!=", "<=", ">=", "==", "=", "<", ">"};
+  for (std::size_t pos = 0; pos < text.size(); ++pos)
+    for (const char* op : ops) {
+      const std::string o(op);
+      if (text.compare(pos, o.size(), o) == 0) {
+        Filter f{text.substr(0, pos), o == "==" ? "=" : o, text.substr(pos + o.size())};
+        auto trim = [](std::string& s) {
+          s.erase(0, s.find_first_not_of(" \t"));
+          s.erase(s.find_last_not_of(" \t") + 1);
+        };
+        trim(f.field);
+        trim(f.value);
+        if (f.field.empty() || f.value.empty()) break;
+        return f;
+      }
+    }
+  throw InputError("--where \"" + text +
+                   "\": expected FIELD OP VALUE with OP one of = != < <= > >= "
+                   "(e.g. --where phi=0.2 --where 'F>10' --where status=completed)");
+}
+
+namespace {
+
+std::string format_number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string value_text(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number_float()) return format_number(v.get<double>());
+  return v.dump();
+}
+
+struct Table {
+  std::vector<std::string> columns;
+  std::vector<std::map<std::string, json>> rows;  // column -> value (null when absent)
+};
+
+// Rows: every run of the chosen sweep(s), with axes, result and observables.
+Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* cases) {
+  std::vector<db::SweepRecord> sweeps;
+  if (o.sweep) {
+    auto s = db.find_sweep(*o.sweep);
+    if (!s) {
+      std::string known;
+      for (const auto& k : db.sweeps()) known += (known.empty() ? "" : ", ") + k.name;
+      throw InputError("--sweep " + *o.sweep + ": no such sweep in " + db.path() +
+                       " (known: " + (known.empty() ? "none" : known) + ")");
+    }
+    sweeps.push_back(*s);
+  } else {
+    sweeps = db.sweeps();
+  }
+  Table t;
+  t.columns = {"run", "sweep", "status"};
+  std::vector<std::string> axes, observables;
+  std::set<std::string> seen_runs;
+  for (const db::SweepRecord& s : sweeps) {
+    for (const json& a : json::parse(s.axes_json))
+      if (std::find(axes.begin(), axes.end(), a.get<std::string>()) == axes.end())
+        axes.push_back(a.get<std::string>());
+  }
+  for (const db::SweepRecord& s : sweeps) {
+    for (db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
+      if (!seen_runs.insert(r.run.id).second) continue;  // shared by two sweeps: list once
+      std::map<std::string, json> row;
+      const json c = json::parse(r.run.case_json);
+      row["run"] = r.run.id.substr(0, 12);
+      row["sweep"] = s.name;
+      row["status"] = r.run.status;
+      for (const std::string& a : axes) row[a] = get_path(c, a).value_or(json());
+      for (const db::Observable& ob : r.observables) {
+        if (std::find(observables.begin(), observables.end(), ob.name) == observables.end())
+          observables.push_back(ob.name);
+        row[ob.name] = ob.mean;
+        row[ob.name + "_err"] = ob.error ? json(*ob.error) : json();
+      }
+      row["wall_s"] = r.wall_s ? json(*r.wall_s) : json();
+      row["mlups"] = r.mlups ? json(*r.mlups) : json();
+      row["attempts"] = r.run.attempts;
+      row["error"] = r.run.error;
+      t.rows.push_back(std::move(row));
+      if (cases) cases->push_back(c);
+    }
+  }
+  for (const std::string& a : axes) t.columns.push_back(a);
+  for (const std::string& ob : observables) {
+    t.columns.push_back(ob);
+    t.columns.push_back(ob + "_err");
+  }
+  for (const char* c : {"wall_s", "mlups", "attempts"}) t.columns.push_back(c);
+  return t;
+}
+
+bool as_number(const json& v, double& out) {
+  if (v.is_number()) {
+    out = v.get<double>();
+    return true;
+  }
+  if (v.is_string()) {
+    const std::string s = v.get<std::string>();
+    char* end = nullptr;
+    out = std::strtod(s.c_str(), &end);
+    return !s.empty() && end == s.c_str() + s.size();
+  }
+  return false;
+}
+
+bool matches(const json& v, const Filter& f) {
+  if (v.is_null()) return false;
+  double a = 0, b = 0;
+  if (as_number(v, a) && as_number(json(f.value), b)) {
+    // Equality tolerates the last digits lost in printing (0.1+0.2 vs 0.3).
+    const bool eq = std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b));
+    if (f.op == "=") return eq;
+    if (f.op == "!=") return !eq;
+    if (f.op == "<") return a < b && !eq;
+    if (f.op == "<=") return a < b || eq;
+    if (f.op == ">") return a > b && !eq;
+    return a > b || eq;
+  }
+  const std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (f.op == "=") return s == f.value;
+  if (f.op == "!=") return s != f.value;
+  if (f.op == "<") return s < f.value;
+  if (f.op == "<=") return s <= f.value;
+  if (f.op == ">") return s > f.value;
+  return s >= f.value;
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"') out += '"';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
+  if (o.format != "table" && o.format != "csv" && o.format != "json")
+    throw InputError("--format " + o.format + ": must be one of table, csv, json");
+  std::vector<json> cases;
+  Table t = build_table(db, o, &cases);
+  // Filters: a column, or else a dotted path into the case.
+  for (const Filter& f : o.where) {
+    const bool is_column =
+        std::find(t.columns.begin(), t.columns.end(), f.field) != t.columns.end() ||
+        f.field == "error";
+    bool known = is_column;
+    for (const json& c : cases) known = known || get_path(c, f.field).has_value();
+    if (!known && !t.rows.empty()) {
+      std::string cols;
+      for (const auto& c : t.columns) cols += (cols.empty() ? "" : ", ") + c;
+      throw InputError("--where " + f.field + f.op + f.value + ": no column or case field \"" +
+                       f.field + "\" (columns: " + cols + "; or a dotted case path)");
+    }
+  }
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    bool ok = true;
+    for (const Filter& f : o.where) {
+      auto it = t.rows[i].find(f.field);
+      json v = it != t.rows[i].end() ? it->second : get_path(cases[i], f.field).value_or(json());
+      ok = ok && matches(v, f);
+    }
+    if (ok) keep.push_back(i);
+  }
+  // Columns no kept row fills (observables of other scenes) are left out.
+  std::vector<std::string> cols;
+  for (const std::string& c : t.columns) {
+    bool any = c == "run" || c == "status";
+    for (std::size_t i : keep) {
+      auto it = t.rows[i].find(c);
+      any = any || (it != t.rows[i].end() && !it->second.is_null());
+    }
+    if (any) cols.push_back(c);
+  }
+  if (o.format == "json") {
+    ordered_json arr = ordered_json::array();
+    for (std::size_t i : keep) {
+      ordered_json row = ordered_json::object();
+      row["id"] = t.rows[i].at("run");
+      for (const std::string& c : cols) {
+        if (c == "run") continue;
+        auto it = t.rows[i].find(c);
+        row[c] = it == t.rows[i].end() ? ordered_json() : ordered_json(it->second);
+      }
+      row["case"] = cases[i];
+      if (!t.rows[i]["error"].get<std::string>().empty()) row["error"] = t.rows[i]["error"];
+      arr.push_back(row);
+    }
+    out << arr.dump(2) << "\n";
+    return static_cast<int>(keep.size());
+  }
+  if (o.format == "csv") {
+    for (std::size_t c = 0; c < cols.size(); ++c) out << (c ? "," : "") << csv_field(cols[c]);
+    out << "\n";
+    for (std::size_t i : keep) {
+      for (std::size_t c = 0; c < cols.size(); ++c) {
+        auto it = t.rows[i].find(cols[c]);
+        out << (c ? "," : "") << csv_field(it == t.rows[i].end() ? "" : value_text(it->second));
+      }
+      out << "\n";
+    }
+    return static_cast<int>(keep.size());
+  }
+  // Aligned table: an observable and its error share a column as "mean ± error".
+  std::vector<std::string> shown;
+  for (const std::string& c : cols)
+    if (!(c.size() > 4 && c.compare(c.size() - 4, 4, "_err") == 0 &&
+          std::find(cols.begin(), cols.end(), c.substr(0, c.size() - 4)) != cols.end()))
+      shown.push_back(c);
+  std::vector<std::vector<std::string>> cells;
+  cells.push_back(shown);
+  for (std::size_t i : keep) {
+    std::vector<std::string> line;
+    for (const std::string& c : shown) {
+      auto it = t.rows[i].find(c);
+      std::string cell = it == t.rows[i].end() ? "" : value_text(it->second);
+      auto e = t.rows[i].find(c + "_err");
+      if (e != t.rows[i].end() && !e->second.is_null()) cell += " ± " + value_text(e->second);
+      line.push_back(cell);
+    }
+    cells.push_back(line);
+  }
+  auto width = [](const std::string& s) {
+    std::size_t w = 0;
+    for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;  // count UTF-8 code points
+    return w;
+  };
+  std::vector<std::size_t> w(shown.size(), 0);
+  for (const auto& line : cells)
+    for (std::size_t c = 0; c < line.size(); ++c) w[c] = std::max(w[c], width(line[c]));
+  for (std::size_t r = 0; r < cells.size(); ++r) {
+    std::string line;
+    for (std::size_t c = 0; c < shown.size(); ++c) {
+      line += cells[r][c] + std::string(w[c] - width(cells[r][c]), ' ');
+      if (c + 1 < shown.size()) line += "  ";
+    }
+    line.erase(line.find_last_not_of(' ') + 1);
+    out << line << "\n";
+  }
+  out << "(" << keep.size() << " of " << t.rows.size() << " runs)\n";
+  return static_cast<int>(keep.size());
+}
+
+namespace {
+std::string duration_text(double s) {
+  char buf[64];
+  if (s < 120)
+    std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else if (s < 7200)
+    std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
+  return buf;
+}
+}  // namespace
+
+void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_name,
+                  std::ostream& out) {
+  std::vector<db::SweepRecord> sweeps;
+  if (sweep_name) {
+    auto s = db.find_sweep(*sweep_name);
+    if (!s) throw InputError("--sweep " + *sweep_name + ": no such sweep in " + db.path());
+    sweeps.push_back(*s);
+  } else {
+    sweeps = db.sweeps();
+  }
+  if (sweeps.empty()) out << "no sweeps in " << db.path() << "\n";
+  const double now = db::unix_now();
+  std::map<std::string, db::AttemptRecord> live;
+  for (db::AttemptRecord& a : db.live_attempts()) live[a.run_id] = a;
+  for (const db::SweepRecord& s : sweeps) {
+    const auto runs = db.runs(s.id);
+    out << "sweep " << s.name << ": " << runs.size() << " runs\n ";
+    for (const db::StateCount& c : db.count_states(s.id))
+      if (c.runs > 0 || c.status == "completed" || c.status == "pending")
+        out << " " << c.status << " " << c.runs;
+    out << "\n";
+    // ETA: what running workers say, plus pending work at the mean wall time so far.
+    double wall_sum = 0;
+    int wall_n = 0, waiting = 0, running = 0;
+    double running_eta = 0;
+    for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
+      if (r.wall_s) wall_sum += *r.wall_s, ++wall_n;
+      if (r.run.status == "pending" || r.run.status == "interrupted" || r.run.status == "lost")
+        ++waiting;
+    }
+    bool header = false;
+    for (const db::RunRecord& r : runs) {
+      auto it = live.find(r.id);
+      if (it == live.end()) continue;
+      const db::AttemptRecord& a = it->second;
+      if (!header) {
+        out << "  running:\n";
+        header = true;
+      }
+      ++running;
+      char line[512];
+      const double beat = a.heartbeat_at.value_or(a.started_at);
+      std::snprintf(line, sizeof line,
+                    "    %s  %-36s %5.1f%%  step %lld/%lld  %s MLUPS  ETA %s  %s pid %lld%s  "
+                    "heartbeat %s ago\n",
+                    r.id.substr(0, 12).c_str(), r.point_json.c_str(), 100 * a.fraction.value_or(0),
+                    static_cast<long long>(a.step.value_or(0)),
+                    static_cast<long long>(a.steps_total.value_or(0)),
+                    a.mlups ? format_number(*a.mlups).c_str() : "-",
+                    a.eta_s ? duration_text(*a.eta_s).c_str() : "?", a.host.c_str(),
+                    static_cast<long long>(a.pid),
+                    a.job_id.empty() ? "" : (" job " + a.job_id).c_str(),
+                    duration_text(now - beat).c_str());
+      out << line;
+      running_eta = std::max(running_eta, a.eta_s.value_or(0));
+    }
+    for (const db::RunRecord& r : runs) {
+      if (r.status != "failed" && r.status != "refused" && r.status != "lost" &&
+          r.status != "interrupted")
+        continue;
+      std::string err = r.error.substr(0, r.error.find('\n'));
+      if (err.size() > 160) err = err.substr(0, 157) + "...";
+      const bool exhausted = r.status == "failed" && r.failures >= s.max_attempts;
+      out << "  " << r.status << " " << r.id.substr(0, 12) << " " << r.point_json << " (attempts "
+          << r.attempts << (exhausted ? ", retry limit reached" : "") << "): " << err << "\n";
+    }
+    if (running > 0 || waiting > 0) {
+      if (wall_n > 0) {
+        const double per_run = wall_sum / wall_n;
+        const int lanes = std::max(running, 1);
+        out << "  ETA: about " << duration_text(running_eta + waiting * per_run / lanes) << " ("
+            << waiting << " waiting at " << duration_text(per_run) << " each, " << lanes
+            << " worker" << (lanes > 1 ? "s" : "") << ")\n";
+      } else {
+        out << "  ETA: unknown until a run completes\n";
+      }
+    }
+  }
+}
+
+}  // namespace flocsim::orchestrator

@@ -1,0 +1,34 @@
+#pragma once
+// What `flocsim query` and `flocsim sweep status` print.
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "db/results_db.hpp"
+
+namespace flocsim::orchestrator {
+
+// One filter of `--where`: FIELD OP VALUE with OP one of = != < <= > >=.
+// FIELD is a column of the query (run, status, an axis, an observable, NAME_err,
+// wall_s, mlups, steps, attempts) or any dotted path into the case
+// ("fluid.size", "run.steps"). Numbers compare as numbers, anything else as text.
+struct Filter {
+  std::string field, op, value;
+};
+// Parses "phi>=0.2"; throws flocsim::input::InputError with the accepted forms.
+Filter parse_filter(const std::string& text);
+
+struct QueryOptions {
+  std::optional<std::string> sweep;  // restrict to one sweep
+  std::vector<Filter> where;
+  std::string format = "table";  // table | csv | json
+};
+
+// Runs the query and writes it to `out`; returns the number of rows written.
+int write_query(db::ResultsDb& db, const QueryOptions& options, std::ostream& out);
+
+// Counts by state, the running runs with progress and ETA, the failures.
+void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep, std::ostream& out);
+
+}  // namespace flocsim::orchestrator

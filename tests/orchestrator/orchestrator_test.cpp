@@ -1,0 +1,417 @@
+// The orchestrator end to end: `flocsim sweep launch|resume|status` and
+// `flocsim query` as processes, against a scriptable fake worker (faults on
+// demand) and the real `flocsim run`. Processes are killed on purpose; the
+// database is then read back directly.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "db/results_db.hpp"
+#include "harness.hpp"
+
+namespace fs = std::filesystem;
+using flocsim::db::ResultsDb;
+using nlohmann::json;
+namespace t = flocsim::test;
+
+namespace {
+
+class Orchestrator : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("flocsim_orch_test_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    db_ = (dir_ / "results.db").string();
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  // A sweep of fake-worker runs over x, each `steps` steps of `step_ms`.
+  std::string fake_sweep(const std::vector<double>& xs, int steps, int step_ms,
+                         const json& fake_extra = json::object(), int max_attempts = 2) {
+    json fake{{"steps", steps}, {"step_ms", step_ms}};
+    fake.update(fake_extra);
+    json s{{"name", "fake"},
+           {"base", {{"x", 0}, {"fake", fake}}},
+           {"axes", {{"x", xs}}},
+           {"max_attempts", max_attempts}};
+    const std::string file = (dir_ / "sweep.json").string();
+    t::write_text(file, s.dump(2));
+    return file;
+  }
+  std::vector<std::string> flocsim(std::vector<std::string> args) {
+    args.insert(args.begin(), FLOCSIM_EXE);
+    return args;
+  }
+  std::vector<std::string> launch(const std::string& sweep, int jobs = 2,
+                                  std::vector<std::string> extra = {}) {
+    std::vector<std::string> a = flocsim({"sweep", "launch", sweep, "--db", db_, "--jobs",
+                                          std::to_string(jobs), "--worker", FAKE_WORKER_EXE});
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  }
+  std::vector<std::string> resume(int jobs = 2) {
+    return flocsim({"sweep", "resume", "--db", db_, "--jobs", std::to_string(jobs), "--worker",
+                    FAKE_WORKER_EXE});
+  }
+  json query() {
+    const t::Output o = t::run(flocsim({"query", "--db", db_, "--format", "json"}));
+    EXPECT_EQ(o.code, 0) << o.out;
+    return json::parse(o.out, nullptr, false);
+  }
+  // Run directory of the run whose case has x.
+  fs::path run_dir(double x) {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    for (const auto& r : db.runs())
+      if (json::parse(r.case_json).value("x", -1.0) == x) return r.run_dir;
+    ADD_FAILURE() << "no run with x = " << x;
+    return {};
+  }
+  std::map<double, std::string> statuses() {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    std::map<double, std::string> out;
+    for (const auto& r : db.runs()) out[json::parse(r.case_json).value("x", -1.0)] = r.status;
+    return out;
+  }
+  int progress_step(double x) {
+    const json p = t::read_json(run_dir(x) / "progress.json");
+    return p.is_object() ? p.value("step", 0) : 0;
+  }
+  void expect_one_result_per_completed_run() {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    EXPECT_EQ(db.integrity_check(), "ok");
+    for (const auto& r : db.runs())
+      EXPECT_EQ(db.count_results(r.id), r.status == "completed" ? 1 : 0) << r.case_json;
+  }
+
+  fs::path dir_;
+  std::string db_;
+};
+
+TEST_F(Orchestrator, LaunchRunsTheGridAndQueryShowsEveryResult) {
+  const std::string sweep = fake_sweep({1, 2, 3, 4}, 4, 20);
+  const t::Output o = t::run(launch(sweep));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("4 runs (4 new, 0 already"), std::string::npos) << o.out;
+  const json rows = query();
+  ASSERT_EQ(rows.size(), 4u);
+  std::set<double> xs;
+  for (const json& r : rows) {
+    EXPECT_EQ(r["status"], "completed");
+    const double x = r["x"].get<double>();
+    xs.insert(x);
+    EXPECT_DOUBLE_EQ(r["twice_x"].get<double>(), 2 * x);  // what the worker computed
+    EXPECT_DOUBLE_EQ(r["twice_x_err"].get<double>(), 0.5);
+    EXPECT_EQ(r["first_step"], 0);
+    EXPECT_EQ(r["attempts"], 1);
+  }
+  EXPECT_EQ(xs, (std::set<double>{1, 2, 3, 4}));
+  // Filters, CSV and the aligned table.
+  t::Output q = t::run(flocsim(
+      {"query", "--db", db_, "--where", "x>=2", "--where", "twice_x<8", "--format", "csv"}));
+  ASSERT_EQ(q.code, 0) << q.out;
+  std::istringstream lines(q.out);
+  std::string header, line;
+  std::getline(lines, header);
+  EXPECT_EQ(
+      header.rfind("run,sweep,status,x,first_step,twice_x,twice_x_err,wall_s,mlups,attempts", 0),
+      0u)
+      << header;
+  int n = 0;
+  while (std::getline(lines, line)) ++n;
+  EXPECT_EQ(n, 2) << q.out;  // x = 2 and 3
+  q = t::run(flocsim({"query", "--db", db_, "--where", "x=3"}));
+  EXPECT_NE(q.out.find("6 ± 0.5"), std::string::npos) << q.out;
+  EXPECT_NE(q.out.find("(1 of 4 runs)"), std::string::npos) << q.out;
+  const t::Output s = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_NE(s.out.find("completed 4"), std::string::npos) << s.out;
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, GrowingTheGridRunsOnlyTheNewPoints) {
+  ASSERT_EQ(t::run(launch(fake_sweep({1, 2}, 3, 10))).code, 0);
+  const t::Output o = t::run(launch(fake_sweep({1, 2, 3}, 3, 10)));
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("3 runs (1 new, 2 already"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("started 1,"), std::string::npos) << o.out;
+  EXPECT_EQ(t::count_lines(run_dir(1) / "starts.log"), 1);
+  EXPECT_EQ(t::count_lines(run_dir(2) / "starts.log"), 1);
+  EXPECT_EQ(t::count_lines(run_dir(3) / "starts.log"), 1);
+  // Launching the same grid again starts nothing.
+  const t::Output again = t::run(launch(fake_sweep({1, 2, 3}, 3, 10)));
+  EXPECT_EQ(again.code, 0);
+  EXPECT_NE(again.out.find("started 0,"), std::string::npos) << again.out;
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, KilledWorkerIsLostThenResumedFromItsCheckpoint) {
+  const std::string sweep = fake_sweep({1, 2}, 40, 50);
+  t::Background orch = t::start(launch(sweep), (dir_ / "launch.log").string());
+  ASSERT_TRUE(
+      t::wait_for([&] { return fs::exists(dir_ / "results.runs") && progress_step(1) >= 5; }, 30));
+  const json p = t::read_json(run_dir(1) / "progress.json");
+  ASSERT_EQ(kill(p["pid"].get<pid_t>(), SIGKILL), 0);
+  EXPECT_EQ(orch.wait(), 1) << t::read_text(dir_ / "launch.log");
+  EXPECT_EQ(statuses()[1], "lost");
+  EXPECT_EQ(statuses()[2], "completed");
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    for (const auto& r : db.runs())
+      if (r.status == "lost") {
+        const auto a = db.attempts(r.id);
+        ASSERT_EQ(a.size(), 1u);
+        EXPECT_EQ(a[0].signal, SIGKILL);
+        EXPECT_NE(a[0].error.find("SIGKILL"), std::string::npos) << a[0].error;
+      }
+  }
+  const t::Output r = t::run(resume());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("(resuming)"), std::string::npos) << r.out;
+  EXPECT_EQ(statuses()[1], "completed");
+  // Two starts: from 0, then from the checkpoint the killed worker left.
+  const std::string starts = t::read_text(run_dir(1) / "starts.log");
+  int second = -1;
+  ASSERT_EQ(std::sscanf(starts.c_str(), "start 0\nstart %d", &second), 1) << starts;
+  EXPECT_GE(second, 5);
+  const json rows = query();
+  for (const json& row : rows)
+    if (row["x"] == 1) EXPECT_EQ(row["first_step"], second);
+  EXPECT_EQ(t::count_lines(run_dir(2) / "starts.log"), 1);  // the finished run did not rerun
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, KilledOrchestratorIsPickedUpByARelaunch) {
+  const std::string sweep = fake_sweep({1, 2, 3, 4}, 30, 50);
+  t::Background orch = t::start(launch(sweep), (dir_ / "launch1.log").string());
+  ASSERT_TRUE(
+      t::wait_for([&] { return fs::exists(dir_ / "results.runs") && progress_step(1) >= 4; }, 30));
+  ASSERT_EQ(kill(orch.pid, SIGKILL), 0);
+  EXPECT_EQ(orch.wait(), 128 + SIGKILL);
+  // The database still says running; the workers checkpoint and stop on their own.
+  EXPECT_EQ(statuses()[1], "running");
+  const t::Output o = t::run(launch(sweep));
+  ASSERT_EQ(o.code, 0) << o.out;
+  for (const auto& [x, status] : statuses()) EXPECT_EQ(status, "completed") << "x = " << x;
+  // Runs that were running continued from a checkpoint; the others started once.
+  const std::string starts1 = t::read_text(run_dir(1) / "starts.log");
+  int second = -1;
+  ASSERT_EQ(std::sscanf(starts1.c_str(), "start 0\nstart %d", &second), 1) << starts1 << o.out;
+  EXPECT_GE(second, 4);
+  EXPECT_EQ(t::count_lines(run_dir(3) / "starts.log"), 1);
+  EXPECT_EQ(t::count_lines(run_dir(4) / "starts.log"), 1);
+  expect_one_result_per_completed_run();
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_TRUE(db.live_attempts().empty());
+}
+
+TEST_F(Orchestrator, TruncatedResultIsNeverRecordedAndRetriesStopAtTheLimit) {
+  const std::string sweep = fake_sweep({1}, 2, 10, {{"truncate", true}}, 2);
+  const t::Output o = t::run(launch(sweep));
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_EQ(statuses()[1], "failed");
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    const auto run = db.runs().front();
+    EXPECT_EQ(db.count_results(run.id), 0);
+    EXPECT_NE(run.error.find("not valid JSON"), std::string::npos) << run.error;
+  }
+  EXPECT_EQ(t::run(resume()).code, 1);  // second attempt, fails the same way
+  const t::Output s = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_NE(s.out.find("retry limit reached"), std::string::npos) << s.out;
+  const t::Output third = t::run(resume());
+  EXPECT_NE(third.out.find("started 0,"), std::string::npos) << third.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 2);
+  EXPECT_NE(db.runs().front().error.find("not valid JSON"), std::string::npos);
+}
+
+TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
+  const t::Output o = t::run(launch(fake_sweep({1}, 2, 10, {{"refuse", true}})));
+  EXPECT_EQ(o.code, 1);
+  EXPECT_EQ(statuses()[1], "refused");
+  t::run(resume());
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 1);
+  EXPECT_NE(db.runs().front().error.find("fake.refuse = true"), std::string::npos)
+      << db.runs().front().error;
+}
+
+TEST_F(Orchestrator, CrashingWorkerFailsWithItsSignal) {
+  t::run(launch(fake_sweep({1}, 5, 10, {{"crash_at", 2}})));
+  EXPECT_EQ(statuses()[1], "failed");
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  const auto a = db.attempts(db.runs().front().id);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].signal, SIGABRT);
+  EXPECT_NE(a[0].error.find("SIGABRT"), std::string::npos) << a[0].error;
+  EXPECT_NE(a[0].error.find("crashing at step 2"), std::string::npos) << a[0].error;
+}
+
+TEST_F(Orchestrator, SigtermStopsWorkersGracefullyAndResumeContinues) {
+  const std::string sweep = fake_sweep({1, 2}, 40, 50);
+  t::Background orch = t::start(launch(sweep), (dir_ / "launch.log").string());
+  ASSERT_TRUE(t::wait_for(
+      [&] {
+        return fs::exists(dir_ / "results.runs") && progress_step(1) >= 3 && progress_step(2) >= 3;
+      },
+      30));
+  kill(orch.pid, SIGTERM);
+  EXPECT_EQ(orch.wait(), 3) << t::read_text(dir_ / "launch.log");
+  for (const auto& [x, status] : statuses()) EXPECT_EQ(status, "interrupted") << x;
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    for (const auto& r : db.runs()) EXPECT_EQ(db.attempts(r.id).front().exit_code, 3);
+  }
+  const t::Output r = t::run(resume());
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const json& row : query()) {
+    EXPECT_EQ(row["status"], "completed");
+    EXPECT_GE(row["first_step"].get<int>(), 3);
+  }
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, ConcurrentQueriesDuringASweepNeverFindTheDatabaseLocked) {
+  const std::string sweep = fake_sweep({1, 2, 3, 4, 5, 6}, 15, 40);
+  t::Background orch = t::start(launch(sweep), (dir_ / "launch.log").string());
+  int queries = 0;
+  int exited = -1;
+  while (exited < 0) {
+    std::vector<t::Background> batch;
+    for (int i = 0; i < 6; ++i)
+      batch.push_back(t::start(flocsim({"query", "--db", db_, "--format", "csv"}),
+                               (dir_ / ("q" + std::to_string(i) + ".log")).string()));
+    batch.push_back(
+        t::start(flocsim({"sweep", "status", "--db", db_}), (dir_ / "status.log").string()));
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const int code = batch[i].wait(60);
+      const std::string log = t::read_text(batch[i].log);
+      // The database may not exist yet in the very first round.
+      if (code != 0 && log.find("does it exist") != std::string::npos) continue;
+      EXPECT_EQ(code, 0) << log;
+      EXPECT_EQ(log.find("locked"), std::string::npos) << log;
+      EXPECT_EQ(log.find("busy"), std::string::npos) << log;
+      ++queries;
+    }
+    int status = 0;
+    if (waitpid(orch.pid, &status, WNOHANG) == orch.pid) {
+      exited = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+      orch.pid = -1;
+    }
+  }
+  EXPECT_EQ(exited, 0);
+  EXPECT_GT(queries, 20);
+  for (const auto& [x, status] : statuses()) EXPECT_EQ(status, "completed") << x;
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, SilentWorkerLosesItsLease) {
+  const t::Output o =
+      t::run(launch(fake_sweep({1}, 400, 20, {{"hang_at", 2}}), 1, {"--lease", "5"}));
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_EQ(statuses()[1], "lost");
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_NE(db.runs().front().error.find("no heartbeat"), std::string::npos)
+      << db.runs().front().error;
+}
+
+TEST_F(Orchestrator, BadInputGetsClearErrorsAndExitCode2) {
+  t::write_text(dir_ / "bad.json", R"({"name": "b", "base": {}, "axes": {"fluid.viscosity": []}})");
+  t::Output o = t::run(launch((dir_ / "bad.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("bad.json: axes.fluid.viscosity = []: must be a non-empty array"),
+            std::string::npos)
+      << o.out;
+  t::write_text(dir_ / "broken.json", R"({"name": "b", "base": {)");
+  o = t::run(launch((dir_ / "broken.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("broken.json: not valid JSON"), std::string::npos) << o.out;
+  o = t::run(flocsim({"query", "--db", (dir_ / "missing.db").string()}));
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.out.find("cannot open results database"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(dir_ / "missing.db"));
+  ASSERT_EQ(t::run(launch(fake_sweep({1}, 1, 1))).code, 0);
+  o = t::run(flocsim({"query", "--db", db_, "--where", "x~1"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("expected FIELD OP VALUE"), std::string::npos) << o.out;
+  o = t::run(flocsim({"query", "--db", db_, "--where", "nosuch=1"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("no column or case field \"nosuch\""), std::string::npos) << o.out;
+}
+
+// The real worker: the CI sweep with `flocsim run`, then a real run killed with
+// SIGKILL and resumed from its HDF5 checkpoint.
+TEST_F(Orchestrator, RealFlocsimRunCompletesTheCiSweep) {
+  const t::Output o = t::run(flocsim(
+      {"sweep", "launch", FLOCSIM_SOURCE_DIR "/sweeps/ci.json", "--db", db_, "--jobs", "2"}));
+  ASSERT_EQ(o.code, 0) << o.out;
+  const json rows = query();
+  ASSERT_EQ(rows.size(), 4u);
+  for (const json& r : rows) {
+    EXPECT_EQ(r["status"], "completed");
+    EXPECT_TRUE(r.contains("wall_s") && r["wall_s"].is_number()) << r.dump();
+  }
+  expect_one_result_per_completed_run();
+}
+
+TEST_F(Orchestrator, RealFlocsimRunKilledMidRunResumesFromCheckpoint) {
+  json s{{"name", "realkill"},
+         {"base",
+          {{"scene", "fluid"},
+           {"fluid",
+            {{"size", {48, 8, 8}},
+             {"viscosity", 0.02},
+             {"initial", {{"type", "shear_wave"}, {"amplitude", 0.01}}}}},
+           {"run",
+            {{"steps", 20000},
+             {"threads", 1},
+             {"progress_every_s", 0.2},
+             {"checkpoint_every_s", 0.5}}}}},
+         {"axes", {{"fluid.viscosity", {0.02}}}}};
+  t::write_text(dir_ / "real.json", s.dump());
+  t::Background orch = t::start(
+      flocsim({"sweep", "launch", (dir_ / "real.json").string(), "--db", db_, "--jobs", "1"}),
+      (dir_ / "launch.log").string());
+  fs::path rd;
+  ASSERT_TRUE(t::wait_for(
+      [&] {
+        if (!fs::exists(dir_ / "results.runs")) return false;
+        for (const auto& e : fs::directory_iterator(dir_ / "results.runs")) rd = e.path();
+        return !rd.empty() && fs::exists(rd / "checkpoint.h5") && fs::exists(rd / "progress.json");
+      },
+      60))
+      << t::read_text(dir_ / "launch.log");
+  const json p = t::read_json(rd / "progress.json");
+  ASSERT_TRUE(p.is_object());
+  ASSERT_EQ(kill(p["pid"].get<pid_t>(), SIGKILL), 0);
+  EXPECT_EQ(orch.wait(), 1) << t::read_text(dir_ / "launch.log");
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    EXPECT_EQ(db.runs().front().status, "lost");
+  }
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_}));
+  ASSERT_EQ(r.code, 0) << r.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  const auto run = db.runs().front();
+  EXPECT_EQ(run.status, "completed");
+  const auto attempts = db.attempts(run.id);
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_TRUE(attempts[1].resumed);
+  EXPECT_EQ(db.count_results(run.id), 1);
+  EXPECT_EQ(db.integrity_check(), "ok");
+  // The run's own log says it continued from the checkpoint.
+  const std::string log = t::read_text(rd / "run.log");
+  EXPECT_NE(log.find("checkpoint"), std::string::npos) << log;
+}
+
+}  // namespace

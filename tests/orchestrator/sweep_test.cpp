@@ -1,0 +1,157 @@
+// Sweep files: canonical cases and their hashes, grid expansion, and the
+// errors a bad sweep file gets.
+#include "orchestrator/sweep.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "engine/input/input_reader.hpp"
+
+using flocsim::input::InputError;
+using nlohmann::json;
+using nlohmann::ordered_json;
+namespace orc = flocsim::orchestrator;
+
+namespace {
+
+orc::SweepSpec parse(const std::string& text) {
+  return orc::parse_sweep(ordered_json::parse(text), "t.json");
+}
+
+// The message of the InputError that parsing (and expanding) `text` raises.
+std::string error_of(const std::string& text) {
+  try {
+    orc::expand(parse(text));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Sha256, MatchesFipsTestVectors) {
+  EXPECT_EQ(orc::sha256_hex(""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(orc::sha256_hex("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(orc::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+}
+
+TEST(Canonical, SortsKeysAndNormalisesNumbers) {
+  const json a =
+      json::parse(R"({"b": 1.0, "a": [2e3, 0.20, -0.0, 1.5], "c": {"z": true, "y": "s"}})");
+  EXPECT_EQ(orc::canonical_text(a), R"({"a":[2000,0.2,0,1.5],"b":1,"c":{"y":"s","z":true}})");
+  const json b = json::parse(R"({"c": {"y": "s", "z": true}, "a": [2000, 0.2, 0, 1.50], "b": 1})");
+  EXPECT_EQ(orc::case_id(a), orc::case_id(b));
+  const json c = json::parse(R"({"c": {"y": "s", "z": true}, "a": [2000, 0.2, 0, 1.5], "b": 2})");
+  EXPECT_NE(orc::case_id(a), orc::case_id(c));
+  EXPECT_EQ(orc::case_id(a).size(), 64u);
+}
+
+TEST(Expand, CartesianProductFirstAxisSlowest) {
+  const auto s = parse(R"({
+    "name": "g", "base": {"scene": "fluid", "fluid": {"viscosity": 0.01}, "run": {"steps": 10}},
+    "axes": {"fluid.viscosity": [0.01, 0.02], "run.steps": [10, 20, 30]}})");
+  const auto runs = orc::expand(s);
+  ASSERT_EQ(runs.size(), 6u);
+  EXPECT_EQ(runs[0].point.dump(), R"({"fluid.viscosity":0.01,"run.steps":10})");
+  EXPECT_EQ(runs[1].point.dump(), R"({"fluid.viscosity":0.01,"run.steps":20})");
+  EXPECT_EQ(runs[3].point.dump(), R"({"fluid.viscosity":0.02,"run.steps":10})");
+  EXPECT_EQ(runs[5].case_json.dump(),
+            R"({"fluid":{"viscosity":0.02},"run":{"steps":30},"scene":"fluid"})");
+  std::set<std::string> ids;
+  for (const auto& r : runs) ids.insert(r.id);
+  EXPECT_EQ(ids.size(), 6u);
+  EXPECT_EQ(runs[5].id, orc::case_id(runs[5].case_json));
+}
+
+TEST(Expand, NewAxisPathsCreateObjectsAndFidelityIsACaseField) {
+  const auto s = parse(R"({"name": "p", "base": {"scene": "suspension"}, "fidelity": "quick",
+    "axes": {"phi": [0.12], "well.du_over_Uinf": [0, 0.005]}})");
+  const auto runs = orc::expand(s);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(
+      runs[1].case_json.dump(),
+      R"({"fidelity":"quick","phi":0.12,"scene":"suspension","well":{"du_over_Uinf":0.005}})");
+  EXPECT_EQ(s.max_attempts, 3);
+}
+
+TEST(Expand, NoAxesIsOneRun) {
+  const auto runs = orc::expand(parse(R"({"name": "one", "base": {"x": 1}, "axes": {}})"));
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].case_json.dump(), R"({"x":1})");
+}
+
+// A grown grid keeps the ids of the points it had: their runs are reused.
+TEST(Expand, GrowingAGridKeepsTheIdsOfOldPoints) {
+  const auto small = orc::expand(
+      parse(R"({"name": "g", "base": {"x": 0, "y": 1.0}, "axes": {"x": [1, 2], "y": [1.0]}})"));
+  const auto grown = orc::expand(
+      parse(R"({"name": "g", "base": {"y": 1, "x": 0}, "axes": {"x": [1.0, 2, 3], "y": [1, 2]}})"));
+  std::set<std::string> grown_ids;
+  for (const auto& r : grown) grown_ids.insert(r.id);
+  for (const auto& r : small) EXPECT_TRUE(grown_ids.count(r.id)) << r.point.dump();
+  EXPECT_EQ(grown.size(), 6u);
+}
+
+TEST(SweepErrors, NameTheFieldTheValueAndWhatIsAllowed) {
+  EXPECT_NE(error_of(R"({"name": "a", "axes": {}})").find("base is missing"), std::string::npos)
+      << error_of(R"({"name": "a", "axes": {}})");
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {"x": []}})")
+                .find("axes.x = []: must be a non-empty array"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {"x": 3}})")
+                .find("axes.x = 3: must be a non-empty array"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {"x": [1, 1.0]}})").find("lists 1 twice"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {"x": [[1]]}})")
+                .find("must be numbers, strings or booleans"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {"fluid": 2}, "axes": {"fluid.nu": [1]}})")
+                .find("goes through base.fluid = 2, which is not an object"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {"a..b": [1]}})").find("empty segment"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(R"({"name": "a", "base": {}, "axes": {"f": [1], "f.g": [2]}})").find("overlap"),
+      std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {}, "axis": {}})").find("axis"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a b", "base": {}, "axes": {}})").find("without spaces"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"name": "a", "base": {}, "axes": {}, "max_attempts": 0})")
+                .find("max_attempts = 0: must be >= 1"),
+            std::string::npos)
+      << error_of(R"({"name": "a", "base": {}, "axes": {}, "max_attempts": 0})");
+  EXPECT_NE(error_of(R"({"name": "a", "base": {"fidelity": "x"}, "axes": {}, "fidelity": "y"})")
+                .find("give it once"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"([1, 2])").find("must hold a JSON object"), std::string::npos);
+  // Every message names the file.
+  EXPECT_EQ(
+      error_of(R"({"name": "a", "base": {}, "axes": {"x": []}})").rfind("sweep file t.json", 0),
+      0u);
+}
+
+TEST(SweepErrors, UnreadableOrInvalidFilesNameTheFile) {
+  try {
+    orc::read_sweep_file("/nonexistent/sweep.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/sweep.json: cannot be opened"),
+              std::string::npos);
+  }
+}
+
+TEST(ShippedSweeps, ParseAndExpandToTheirGrids) {
+  const std::string dir = FLOCSIM_SOURCE_DIR "/sweeps/";
+  EXPECT_EQ(orc::expand(orc::read_sweep_file(dir + "paper.json")).size(), 4u * 5u * 6u);
+  const auto demo = orc::expand(orc::read_sweep_file(dir + "demo.json"));
+  EXPECT_GE(demo.size(), 4u);
+  EXPECT_LE(demo.size(), 12u);
+  EXPECT_GE(orc::expand(orc::read_sweep_file(dir + "ci.json")).size(), 2u);
+}
+
+}  // namespace
