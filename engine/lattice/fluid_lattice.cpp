@@ -307,6 +307,17 @@ void FluidLattice<Real>::step_kernel() {
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y) {
       const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+      // Start of the neighbouring rows (y + dy, z + dz), dy, dz in {-1, 0, 1},
+      // periodic: neighbour_row[dz + 1][dy + 1]. Only unit offsets occur, so
+      // the wrap is a comparison, not an integer division per direction.
+      long neighbour_row[3][3];
+      {
+        const int ys[3] = {y == 0 ? ny - 1 : y - 1, y, y == ny - 1 ? 0 : y + 1};
+        const int zs[3] = {z == 0 ? nz - 1 : z - 1, z, z == nz - 1 ? 0 : z + 1};
+        for (int dz = 0; dz < 3; ++dz)
+          for (int dy = 0; dy < 3; ++dy)
+            neighbour_row[dz][dy] = static_cast<long>(nx) * (ys[dy] + static_cast<long>(ny) * zs[dz]);
+      }
       // Per direction: where this row's incoming populations are read and its
       // outgoing ones written, as pointers indexed by x.
       const Real* load[kQ];
@@ -316,8 +327,8 @@ void FluidLattice<Real>::step_kernel() {
           load[i] = base + i * stride + row;
           store[i] = base + opposite(i) * stride + row;
         } else {
-          const long up = static_cast<long>(nx) * (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
-          const long down = static_cast<long>(nx) * (wrap(y + cy[i], ny) + static_cast<long>(ny) * wrap(z + cz[i], nz));
+          const long up = neighbour_row[1 - cz[i]][1 - cy[i]];
+          const long down = neighbour_row[1 + cz[i]][1 + cy[i]];
           load[i] = base + opposite(i) * stride + up - cx[i];
           store[i] = base + i * stride + down + cx[i];
         }
@@ -357,8 +368,9 @@ void FluidLattice<Real>::step_kernel() {
           const Real* ld[kQ];
           Real* st[kQ];
           for (int i = 0; i < kQ; ++i) {
-            ld[i] = load[i] + cx[i] + wrap(x - cx[i], nx);
-            st[i] = store[i] - cx[i] + wrap(x + cx[i], nx);
+            const int from = x - cx[i], to = x + cx[i];  // within one cell of the row
+            ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
+            st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
           }
           update(x, ld, st, 0, 0);
         }
