@@ -66,7 +66,6 @@ template <class Real>
 struct ImmersedBoundary<Real>::Workspace {
   explicit Workspace(int box, int markers)
       : cells(static_cast<std::size_t>(box) * box * box),
-        known(cells, 0),
         rho(cells),
         ux(cells),
         uy(cells),
@@ -82,10 +81,9 @@ struct ImmersedBoundary<Real>::Workspace {
     touched.reserve(cells);
   }
   std::size_t cells;
-  std::vector<unsigned char> known;
   std::vector<double> rho, ux, uy, uz;  // u*: velocity without immersed-boundary force
   std::vector<double> fx, fy, fz;       // this sphere's force density on the box
-  std::vector<int> touched;             // box cells in some marker's stencil
+  std::vector<int> touched;             // box cells read and written for this sphere
   std::vector<int> global[3];           // wrapped lattice coordinate of each box row
   std::vector<int> base;                // box index of each marker's stencil corner
   std::vector<double> weights;          // 3 x 3 kernel weights of each marker
@@ -196,7 +194,35 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       for (int i = 0; i < B; ++i)
         ws.global[d][static_cast<std::size_t>(i)] = wrap(lo[d] + i, length[d]);
     }
-    // Stencils, targets, and u* on every stencil cell (read once per cell).
+    // u* on every cell within a_g + 2.6 of the centre (all marker stencils,
+    // sqrt(3) * 1.5 < 2.6, and the inside of the sphere), row by row so that
+    // the 19 population streams are read in order.
+    const double reach_sq = (ag + 2.6) * (ag + 2.6);
+    for (int k = 0; k < B; ++k) {
+      const double rz = lo[2] + k - centre[2];
+      for (int j = 0; j < B; ++j) {
+        const double ry = lo[1] + j - centre[1];
+        const double left = reach_sq - ry * ry - rz * rz;
+        if (left <= 0) continue;
+        const double half = std::sqrt(left);
+        const int i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
+        const int i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
+        const int gy = ws.global[1][static_cast<std::size_t>(j)];
+        const int gz = ws.global[2][static_cast<std::size_t>(k)];
+        const int row = B * (j + B * k);
+        for (int i = i0; i <= i1; ++i) ws.touched.push_back(row + i);
+        // Read the row in pieces that do not cross the periodic edge in x.
+        for (int i = i0; i <= i1;) {
+          const int gx = ws.global[0][static_cast<std::size_t>(i)];
+          const int count = std::min(i1 - i + 1, length[0] - gx);
+          const std::size_t lc = static_cast<std::size_t>(row + i);
+          fluid.macroscopic_row_without_force_field(gx, count, gy, gz, &ws.rho[lc], &ws.ux[lc],
+                                                    &ws.uy[lc], &ws.uz[lc]);
+          i += count;
+        }
+      }
+    }
+    // Stencils and targets of the markers.
     for (int m = 0; m < markers; ++m) {
       const Vec3 r = ag * directions_[static_cast<std::size_t>(m)];
       const Vec3 X = centre + r;
@@ -212,25 +238,6 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       }
       ws.target[static_cast<std::size_t>(m)] = up + omega.cross(r);
       ws.marker_force[static_cast<std::size_t>(m)].setZero();
-      for (int c = 0; c < 3; ++c)
-        for (int bb = 0; bb < 3; ++bb) {
-          const int row = b + B * (bb + B * c);
-          for (int a = 0; a < 3; ++a) {
-            const int cell = row + a;
-            if (ws.known[static_cast<std::size_t>(cell)]) continue;
-            ws.known[static_cast<std::size_t>(cell)] = 1;
-            ws.touched.push_back(cell);
-            const int i = cell % B, j = (cell / B) % B, k = cell / (B * B);
-            const lattice::Macroscopic mac =
-                fluid.macroscopic_without_force_field(ws.global[0][static_cast<std::size_t>(i)],
-                                                      ws.global[1][static_cast<std::size_t>(j)],
-                                                      ws.global[2][static_cast<std::size_t>(k)]);
-            ws.rho[static_cast<std::size_t>(cell)] = mac.density;
-            ws.ux[static_cast<std::size_t>(cell)] = mac.velocity.x;
-            ws.uy[static_cast<std::size_t>(cell)] = mac.velocity.y;
-            ws.uz[static_cast<std::size_t>(cell)] = mac.velocity.z;
-          }
-        }
     }
     // Interpolated density and velocity (with the force so far) at marker m.
     auto interpolate = [&](int m, double& rho, Vec3& u) {
@@ -318,20 +325,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
           const double dist = std::sqrt(rx * rx + ry * ry + rz * rz);
           const double w = std::min(1.0, reach - dist);
           if (w <= 0) continue;
-          const int cell = i + B * (j + B * k);
-          const std::size_t lc = static_cast<std::size_t>(cell);
-          if (!ws.known[lc]) {
-            ws.known[lc] = 1;
-            ws.touched.push_back(cell);
-            const lattice::Macroscopic mac =
-                fluid.macroscopic_without_force_field(ws.global[0][static_cast<std::size_t>(i)],
-                                                      ws.global[1][static_cast<std::size_t>(j)],
-                                                      ws.global[2][static_cast<std::size_t>(k)]);
-            ws.rho[lc] = mac.density;
-            ws.ux[lc] = mac.velocity.x;
-            ws.uy[lc] = mac.velocity.y;
-            ws.uz[lc] = mac.velocity.z;
-          }
+          const std::size_t lc = static_cast<std::size_t>(i + B * (j + B * k));
           const Vec3 j_cell(ws.rho[lc] * ws.ux[lc] + 0.5 * ws.fx[lc],
                             ws.rho[lc] * ws.uy[lc] + 0.5 * ws.fy[lc],
                             ws.rho[lc] * ws.uz[lc] + 0.5 * ws.fz[lc]);
@@ -352,7 +346,6 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       field[0][g] += static_cast<Real>(ws.fx[lc]);
       field[1][g] += static_cast<Real>(ws.fy[lc]);
       field[2][g] += static_cast<Real>(ws.fz[lc]);
-      ws.known[lc] = 0;
       ws.fx[lc] = ws.fy[lc] = ws.fz[lc] = 0.0;
     }
     ws.touched.clear();

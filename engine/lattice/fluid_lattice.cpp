@@ -219,6 +219,51 @@ Macroscopic FluidLattice<Real>::macroscopic_without_force_field(int x, int y, in
 }
 
 template <class Real>
+void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, int y, int z,
+                                                             double* density, double* ux,
+                                                             double* uy, double* uz) const {
+  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
+  const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+  const bool even = time_step_ % 2 == 0;
+  // Population i of cell x is at p[i][x]: its own slot (even step) or the
+  // opposite slot of the upstream cell (odd step). Interior cells only; the
+  // two end cells of the row go through the wrapping path.
+  const Real* p[kQ];
+  for (int i = 0; i < kQ; ++i) {
+    if (even) {
+      p[i] = storage(i) + row;
+    } else {
+      const long up = static_cast<long>(nx) * (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
+      p[i] = storage(opposite(i)) + up - cx[i];
+    }
+  }
+  const double bx = 0.5 * body_force_.x, by = 0.5 * body_force_.y, bz = 0.5 * body_force_.z;
+  for (int k = 0; k < count; ++k) {
+    const int x = x0 + k;
+    if (!even && (x == 0 || x == nx - 1)) {
+      const Macroscopic m = macroscopic_without_force_field(x, y, z);
+      density[k] = m.density;
+      ux[k] = m.velocity.x;
+      uy[k] = m.velocity.y;
+      uz[k] = m.velocity.z;
+      continue;
+    }
+    double f[kQ];
+    for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
+    double drho = 0;
+    for (int i = 0; i < kQ; ++i) drho += f[i];
+    const double jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
+    const double jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
+    const double jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
+    const double rho = 1.0 + drho, inv = 1.0 / rho;
+    density[k] = rho;
+    ux[k] = (jx + bx) * inv;
+    uy[k] = (jy + by) * inv;
+    uz[k] = (jz + bz) * inv;
+  }
+}
+
+template <class Real>
 void FluidLattice<Real>::macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,
                                             std::vector<double>& uy,
                                             std::vector<double>& uz) const {

@@ -88,6 +88,10 @@ class FluidLattice {
   // without the immersed-boundary force (direct forcing needs it). x, y, z must
   // lie inside the box. Cheaper than macroscopic(): no modulo for interior cells.
   Macroscopic macroscopic_without_force_field(int x, int y, int z) const;
+  // The same for `count` consecutive cells x0 .. x0 + count - 1 of row (y, z)
+  // (inside the box, no wrap in x), written to density[k], ux[k], uy[k], uz[k].
+  void macroscopic_row_without_force_field(int x0, int count, int y, int z, double* density,
+                                           double* ux, double* uy, double* uz) const;
 
   // Density and velocity of every cell (arrays of length cells(), x fastest).
   void macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,

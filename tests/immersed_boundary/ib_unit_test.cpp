@@ -67,6 +67,16 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
           EXPECT_NEAR(bare.velocity.z,
                       full.velocity.z - 0.5 * fluid.force_field(2)[c] / full.density, 1e-15);
         }
+    // The row reader gives the same numbers, edge cells included.
+    double rho[9], ux[9], uy[9], uz[9];
+    fluid.macroscopic_row_without_force_field(0, 9, 6, 5, rho, ux, uy, uz);
+    for (int x = 0; x < 9; ++x) {
+      const auto bare = fluid.macroscopic_without_force_field(x, 6, 5);
+      EXPECT_NEAR(rho[x], bare.density, 1e-15);
+      EXPECT_NEAR(ux[x], bare.velocity.x, 1e-15);
+      EXPECT_NEAR(uy[x], bare.velocity.y, 1e-15);
+      EXPECT_NEAR(uz[x], bare.velocity.z, 1e-15);
+    }
   }
   fluid.clear_force_field();
   EXPECT_EQ(fluid.force_field(2)[17], 0.0);
