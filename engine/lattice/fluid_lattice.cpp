@@ -408,8 +408,9 @@ void FluidLattice<Real>::step_kernel() {
       // Odd steps: the two end cells of the row stream across the periodic
       // boundary in x; give them explicitly wrapped pointers.
       if (!even) {
-        for (int x : {0, nx - 1}) {
-          if (x == nx - 1 && nx == 1) break;
+        // the first and the last cell of the row: one cell when nx == 1
+        for (int end = 0; end < (nx == 1 ? 1 : 2); ++end) {
+          const int x = end == 0 ? 0 : nx - 1;
           const Real* ld[kQ];
           Real* st[kQ];
           for (int i = 0; i < kQ; ++i) {
