@@ -88,7 +88,7 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   if (wave) {
     in.amplitude = init.number("amplitude", {.at_least = 0, .at_most = kMaxLatticeSpeed,
                                              .why = "(Mach limit |u| <= 0.2 c_s)"});
-    in.wavelengths = static_cast<int>(init.integer("wavelengths", {.at_least = 1}, 1));
+    in.wavelengths = static_cast<int>(init.integer("wavelengths", {.at_least = 1, .at_most = 1024}, 1));
   }
   if (in.type == "shear_wave") {
     in.axis = axis_index(init.choice("axis", {"x", "y", "z"}, "x"));

@@ -111,18 +111,22 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.progress_every_s = pr.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
   c.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
   pr.finish();
-  if (c.statistics < 5 * c.sample_every)
-    throw InputError("protocol.statistics = " + format(c.statistics) + ": must be >= 5 x protocol.sample_every = " +
-                     format(5 * c.sample_every) + " (batch means need samples)");
+  if (c.statistics < 20 * c.sample_every)
+    throw InputError("protocol.statistics = " + format(c.statistics) + ": must be >= 20 x protocol.sample_every = " +
+                     format(20 * c.sample_every) + " (10 batch means of at least 2 samples each)");
   root.finish();
 
   // ---- lattice-unit quantities (SPEC section 2) -----------------------------
   const int L = static_cast<int>(std::lround(c.length_over_a * a));
   const int W = static_cast<int>(std::lround(L / c.length_over_width));
   c.box = {L, W, W};
-  if (W < 4 * a)
-    throw InputError("L_over_W = " + format(c.length_over_width) + ": makes the box width W = " + std::to_string(W) +
-                     " cells, less than 4a = " + format(4 * a) + "; must leave room for a sphere and its neighbours");
+  // Pair observables look up to 3a around each sphere (h(theta), and the
+  // well and event ranges, 2(a + delta) plus a skin, are shorter): that must
+  // stay below half the box so that a pair has one periodic image only.
+  if (W <= 6 * a)
+    throw InputError("L_over_W = " + format(c.length_over_width) + " with L_over_a = " + format(c.length_over_a) +
+                     ": makes the box width W = " + std::to_string(W) + " cells; must exceed 6a = " + format(6 * a) +
+                     " so that pairs within 3a have a single periodic image");
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
   c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));

@@ -1,6 +1,7 @@
 #include "engine/input/input_reader.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -75,6 +76,9 @@ long InputReader::integer(const std::string& key, const Range& range, std::optio
   }
   if (!v->is_number_integer())
     throw InputError(field(key) + " = " + v->dump() + ": must be an integer " + range.describe());
+  // an unsigned value beyond the range of long would wrap: refuse it
+  if (v->is_number_unsigned() && v->get<unsigned long>() > static_cast<unsigned long>(LONG_MAX))
+    throw InputError(field(key) + " = " + v->dump() + ": must be " + range.describe());
   const long x = v->get<long>();
   if (!range.contains(static_cast<double>(x)))
     throw InputError(field(key) + " = " + std::to_string(x) + ": must be " + range.describe());

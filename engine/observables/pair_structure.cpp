@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "engine/neighbours/pair_search.hpp"
 
@@ -34,6 +35,16 @@ void PairStructure::add_configuration(const std::vector<spheres::Vec3>& position
   }
   g_normalisation_ += n * (n - 1) / box.volume();
   ++configurations_;
+}
+
+void PairStructure::restore(const Accumulated& a) {
+  if (a.g_counts.size() != g_counts_.size() || a.h_counts.size() != h_counts_.size())
+    throw std::invalid_argument("PairStructure::restore: bin counts differ from this accumulator's");
+  g_counts_ = a.g_counts;
+  h_counts_ = a.h_counts;
+  g_normalisation_ = a.g_normalisation;
+  h_pairs_ = a.h_pairs;
+  configurations_ = a.configurations;
 }
 
 std::vector<double> PairStructure::radial_distribution() const {

@@ -27,6 +27,17 @@ class PairStructure {
   std::vector<double> angular_bin_centres() const;
   long configurations() const { return configurations_; }
 
+  // The raw accumulators, for checkpoints.
+  struct Accumulated {
+    std::vector<double> g_counts, h_counts;
+    double g_normalisation = 0, h_pairs = 0;
+    long configurations = 0;
+  };
+  Accumulated accumulated() const {
+    return {g_counts_, h_counts_, g_normalisation_, h_pairs_, configurations_};
+  }
+  void restore(const Accumulated& a);
+
  private:
   double r_max_g_, dr_, r_max_h_, dtheta_;
   std::vector<double> g_counts_, h_counts_;

@@ -68,17 +68,40 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches) {
     for (long k = 0; k < per; ++k) s += series[start + b * per + k];
     means[b] = s / per;
   }
-  double mean = 0;
-  for (double m : means) mean += m;
-  mean /= batches;
+  double batch_mean = 0;
+  for (double m : means) batch_mean += m;
+  batch_mean /= batches;
   double var = 0;
-  for (double m : means) var += (m - mean) * (m - mean);
+  for (double m : means) var += (m - batch_mean) * (m - batch_mean);
   var /= (batches - 1);
-  out.mean = mean;
+  double all = 0;
+  for (double x : series) all += x;
+  out.mean = all / static_cast<double>(series.size());
   out.error = std::sqrt(var / batches);
   out.batches = batches;
-  out.samples = per * batches;
+  out.correlation_samples = integrated_correlation_time(series);
+  out.error_reliable = static_cast<double>(per) >= 5.0 * out.correlation_samples;
   return out;
+}
+
+double integrated_correlation_time(const std::vector<double>& series) {
+  const std::size_t n = series.size();
+  if (n < 3) return 1.0;
+  double mean = 0;
+  for (double x : series) mean += x;
+  mean /= static_cast<double>(n);
+  double c0 = 0;
+  for (double x : series) c0 += (x - mean) * (x - mean);
+  if (c0 <= 0) return 1.0;  // a constant series: no correlation to speak of
+  double tau = 1.0;
+  for (std::size_t lag = 1; lag < n / 2; ++lag) {
+    double c = 0;
+    for (std::size_t i = 0; i + lag < n; ++i) c += (series[i] - mean) * (series[i + lag] - mean);
+    const double rho = c / c0;
+    if (rho <= 0) break;
+    tau += 2.0 * rho;
+  }
+  return tau;
 }
 
 bool is_stationary(const std::vector<double>& series, long window, double tolerance) {

@@ -30,12 +30,20 @@ std::vector<double> slab_solids_fraction(const std::vector<spheres::Vec3>& posit
 // to independent when a batch is much longer than the correlation time; the
 // error is their standard deviation over sqrt(batches).
 struct SteadyAverage {
-  double mean = 0;
-  double error = 0;
+  double mean = 0;   // over every sample of the series
+  double error = 0;  // batch-means standard error of the mean
   long samples = 0;
   int batches = 0;
+  // Integrated autocorrelation time in samples, tau = 1 + 2 sum_k rho(k),
+  // summed until the autocorrelation first drops below zero. The error is
+  // trustworthy when a batch spans several tau (batch_length >= 5 tau).
+  double correlation_samples = 0;
+  bool error_reliable = false;
 };
 SteadyAverage batch_means(const std::vector<double>& series, int batches);
+
+// Integrated autocorrelation time of a series, in samples (see SteadyAverage).
+double integrated_correlation_time(const std::vector<double>& series);
 
 // Dynamically stationary: the means of the last two windows of `window`
 // samples differ by less than `tolerance` standard errors of their difference

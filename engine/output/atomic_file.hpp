@@ -10,9 +10,22 @@ namespace flocsim::output {
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& content);
 
-// For files written by a library (HDF5): the temporary name to write to, and
-// the commit that makes it final (fsync of the file and its directory, rename).
-std::filesystem::path temporary_name_for(const std::filesystem::path& path);
-void commit_temporary(const std::filesystem::path& temporary, const std::filesystem::path& path);
+// For files written by a library (HDF5): write to path(), then commit() makes
+// it final (fsync of the file and its directory, rename). A TemporaryFile
+// destroyed without a commit (an exception on the way) removes its file, so
+// a failed write never replaces the previous complete file nor leaves debris.
+class TemporaryFile {
+ public:
+  explicit TemporaryFile(std::filesystem::path final_path);
+  ~TemporaryFile();
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const std::filesystem::path& path() const { return temporary_; }
+  void commit();
+
+ private:
+  std::filesystem::path final_, temporary_;
+  bool committed_ = false;
+};
 
 }  // namespace flocsim::output

@@ -1,8 +1,9 @@
 #pragma once
-// Snapshots of the macroscopic liquid fields (density, velocity) in one HDF5
-// file, group /step_NNNNNNNNNN per snapshot, arrays shaped [nz][ny][nx] (x
-// fastest, as the lattice stores them), plus an XDMF file next to it so that
-// ParaView opens the time series directly.
+// Snapshots of the macroscopic liquid fields (density, velocity): one HDF5
+// file per snapshot, <directory>/step_NNNNNNNNNN.h5, written atomically (a
+// crash can lose the snapshot being written, never an earlier one), arrays
+// shaped [nz][ny][nx] (x fastest, as the lattice stores them), plus the XDMF
+// index <directory>.xdmf that ParaView opens as a time series.
 #include <filesystem>
 #include <vector>
 
@@ -17,11 +18,10 @@ struct FieldSnapshot {
   const std::vector<double>* uz = nullptr;
 };
 
-// Appends a snapshot to `h5` (created if absent; a snapshot of the same step is
-// replaced) and rewrites the XDMF index `h5` with extension .xdmf.
-void append_field_snapshot(const std::filesystem::path& h5, const FieldSnapshot& s);
+void write_field_snapshot(const std::filesystem::path& directory, const FieldSnapshot& s);
 
-// Steps present in the file, ascending.
-std::vector<long> snapshot_steps(const std::filesystem::path& h5);
+// Steps of the snapshot files in a snapshot directory, ascending.
+std::vector<long> snapshot_steps(const std::filesystem::path& directory);
+std::filesystem::path snapshot_file(const std::filesystem::path& directory, long step);
 
 }  // namespace flocsim::output

@@ -42,6 +42,14 @@ Hdf5File::~Hdf5File() {
   if (file_ >= 0) H5Fclose(file_);
 }
 
+void Hdf5File::close() {
+  if (file_ < 0) return;
+  const herr_t flushed = H5Fflush(file_, H5F_SCOPE_LOCAL);
+  const herr_t closed = H5Fclose(file_);
+  file_ = -1;
+  if (flushed < 0 || closed < 0) throw std::runtime_error("cannot complete HDF5 file " + path_.string());
+}
+
 void Hdf5File::create_group(const std::string& name) {
   Handle g{H5Gcreate2(file_, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
   if (g.id < 0) throw std::runtime_error(path_.string() + ": cannot create group " + name);

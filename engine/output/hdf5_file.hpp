@@ -15,7 +15,10 @@ class Hdf5File {
  public:
   enum class Mode { create, read, append };
   Hdf5File(const std::filesystem::path& path, Mode mode);
-  ~Hdf5File();
+  ~Hdf5File();  // closes, ignoring errors: call close() where they matter
+  // Flushes and closes, throwing when HDF5 cannot complete the file (full
+  // disk, quota): a checkpoint must not be committed after a failed close.
+  void close();
   Hdf5File(const Hdf5File&) = delete;
   Hdf5File& operator=(const Hdf5File&) = delete;
 

@@ -1,8 +1,8 @@
 #pragma once
-// Snapshots of the spheres (positions, velocities, aggregate ids) in one HDF5
-// file, group /step_NNNNNNNNNN per snapshot, with an XDMF index next to it so
-// ParaView shows them as points (apply a Glyph filter with the radius stored
-// in the file's "radius" attribute to see spheres).
+// Snapshots of the spheres (positions, velocities, angular velocities,
+// aggregate ids): one HDF5 file per snapshot, <directory>/step_NNNNNNNNNN.h5,
+// written atomically, plus the XDMF index <directory>.xdmf so ParaView shows
+// them as points (a Glyph filter with the "radius" attribute draws spheres).
 #include <filesystem>
 #include <vector>
 
@@ -10,8 +10,7 @@
 
 namespace flocsim::output {
 
-// Appends (replacing a snapshot of the same step) and rewrites the .xdmf.
-void append_sphere_snapshot(const std::filesystem::path& h5, long step, double time,
-                            const spheres::SphereSet& spheres, const std::vector<int>& aggregate_of);
+void write_sphere_snapshot(const std::filesystem::path& directory, long step, double time,
+                           const spheres::SphereSet& spheres, const std::vector<int>& aggregate_of);
 
 }  // namespace flocsim::output

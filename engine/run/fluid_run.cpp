@@ -5,12 +5,14 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <fstream>
 #include <limits>
 
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/stop_signal.hpp"
 
@@ -46,7 +48,7 @@ double wave_amplitude(const FluidLattice<Real>& fluid, const cases::FluidCase& c
   const auto& in = c.initial;
   if (in.type != "shear_wave" && in.type != "taylor_green") return 0.0;
   const lattice::Extent e = fluid.extent();
-  double s = 0, q = 0;
+  double s = 0, q = 0, p = 0, t = 0;
   for (int z = 0; z < e.nz; ++z)
     for (int y = 0; y < e.ny; ++y)
       for (int x = 0; x < e.nx; ++x) {
@@ -58,24 +60,31 @@ double wave_amplitude(const FluidLattice<Real>& fluid, const cases::FluidCase& c
           s += u[in.component] * std::sin(k * r[in.axis]);
           q += u[in.component] * std::cos(k * r[in.axis]);
         } else {
-          // project u_a onto -cos(k1 a) sin(k2 b): amplitude U
+          // u_a = -U cos(k1 (a - a0)) sin(k2 (b - b0)): project on the four
+          // products of cos and sin so that the amplitude U comes out whatever
+          // the phase (the vortex is carried along by a mean flow)
           const int a = in.plane_first, b = in.plane_second;
           const double k1 = 2 * M_PI * in.wavelengths / (a == 0 ? e.nx : a == 1 ? e.ny : e.nz);
           const double k2 = 2 * M_PI * in.wavelengths / (b == 0 ? e.nx : b == 1 ? e.ny : e.nz);
-          s += -u[a] * std::cos(k1 * r[a]) * std::sin(k2 * r[b]);
+          const double ca = std::cos(k1 * r[a]), sa = std::sin(k1 * r[a]);
+          const double cb = std::cos(k2 * r[b]), sb = std::sin(k2 * r[b]);
+          s += u[a] * ca * sb;
+          q += u[a] * sa * sb;
+          p += u[a] * ca * cb;
+          t += u[a] * sa * cb;
         }
       }
   const double n = static_cast<double>(e.cells());
-  return in.type == "shear_wave" ? 2.0 * std::hypot(s, q) / n : 4.0 * s / n;
+  if (in.type == "shear_wave") return 2.0 * std::hypot(s, q) / n;
+  return 4.0 * std::sqrt(s * s + q * q + p * p + t * t) / n;
 }
 
 template <class Real>
 void write_checkpoint(const fs::path& dir, const FluidLattice<Real>& fluid, const cases::FluidCase& c,
                       const Baseline& base, double wall_s) {
-  const fs::path final_path = dir / "checkpoint.h5";
-  const fs::path tmp = output::temporary_name_for(final_path);
+  output::TemporaryFile tmp(dir / "checkpoint.h5");
   {
-    output::Hdf5File f(tmp, output::Hdf5File::Mode::create);
+    output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
     f.create_group("/fluid");
     const std::vector<hsize_t> shape = {static_cast<hsize_t>(fluid.extent().cells())};
     for (int i = 0; i < d3q19::kQ; ++i)
@@ -89,16 +98,16 @@ void write_checkpoint(const fs::path& dir, const FluidLattice<Real>& fluid, cons
     f.set_attribute("/", "baseline_momentum_z", base.momentum.z);
     f.set_attribute("/", "baseline_amplitude", base.amplitude);
     f.set_attribute("/", "wall_s", wall_s);
+    f.close();
   }
-  output::commit_temporary(tmp, final_path);
+  tmp.commit();
 }
 
 template <class Real>
 void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const cases::FluidCase& c,
                      Baseline& base) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
-  const std::string stored_case = f.attribute_string("/", "case");
-  if (stored_case != c.to_json().dump())
+  if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
     throw input::InputError(file.string() + " belongs to a different case; remove it or use another --out directory");
   for (int i = 0; i < d3q19::kQ; ++i) {
     const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
@@ -120,13 +129,21 @@ void write_fields(const fs::path& dir, const FluidLattice<Real>& fluid) {
   std::vector<double> rho, ux, uy, uz;
   fluid.macroscopic_fields(rho, ux, uy, uz);
   const auto e = fluid.extent();
-  output::append_field_snapshot(dir / "fields.h5", {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
+  output::write_field_snapshot(dir / "fields", {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
 }
 
 template <class Real>
 RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
-  fs::create_directories(o.out_dir);
+  const StartMode start = prepare_output_directory(o.out_dir, o.resume);
   RunLog log(o.out_dir / "run.log", o.quiet);
+  if (start == StartMode::already_completed) {
+    log.info("already completed: " + (o.out_dir / "result.json").string() + " is kept as it is");
+    RunReport r;
+    r.outcome = RunOutcome::completed;
+    std::ifstream in(o.out_dir / "result.json");
+    r.result = nlohmann::json::parse(in);
+    return r;
+  }
   for (const auto& w : c.warnings) log.warning(w);
   if (c.run.threads > 0) omp_set_num_threads(c.run.threads);
   const Clock::time_point t_start = Clock::now();
@@ -135,7 +152,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   fluid.set_body_force(c.body_force);
   Baseline base;
   const fs::path checkpoint = o.out_dir / "checkpoint.h5";
-  if (o.resume && fs::exists(checkpoint)) {
+  if (start == StartMode::from_checkpoint) {
     read_checkpoint(checkpoint, fluid, c, base);
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(fluid.time_step()));
   } else {
@@ -154,7 +171,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
                             c.size.cells(), c.run.progress_every_s);
   double fluid_s = 0, output_s = 0, checkpoint_s = 0;
   Clock::time_point last_checkpoint = Clock::now();
-  long last_good_checkpoint_step = fs::exists(checkpoint) && o.resume ? fluid.time_step() : -1;
+  long last_good_checkpoint_step = start == StartMode::from_checkpoint ? fluid.time_step() : -1;
   const long first_step = fluid.time_step();
   // A blow-up shows as a non-finite population, which makes the mass sum
   // non-finite; checking it every few steps costs about 1 % of the run.
@@ -188,7 +205,8 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
       output_s += seconds_since(t1);
     }
     const bool stop_now = stop_requested() != 0 || (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
-    const bool checkpoint_due = seconds_since(last_checkpoint) >= c.run.checkpoint_every_s;
+    const bool checkpoint_due = seconds_since(last_checkpoint) >= c.run.checkpoint_every_s ||
+                                (o.checkpoint_every_steps > 0 && t % o.checkpoint_every_steps == 0);
     if ((stop_now || checkpoint_due) && t < c.run.steps) {
       // only a state that passed the health check is checkpointed
       if (!std::isfinite(fluid.total_mass())) continue;

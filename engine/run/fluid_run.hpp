@@ -23,6 +23,9 @@ struct RunOptions {
   // Stop after this many steps of this invocation as if SIGTERM had arrived
   // (checkpoint, exit code 3). For restart tests; 0 = never.
   long stop_after_steps = 0;
+  // Also checkpoint every this many steps (0 = by wall time only): makes
+  // checkpoint placement deterministic for tests.
+  long checkpoint_every_steps = 0;
 };
 
 enum class RunOutcome { completed, interrupted, failed };

@@ -6,16 +6,19 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <fstream>
 #include <random>
 
 #include "engine/events/direct_interactions.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/observables/aggregates.hpp"
+#include "engine/observables/pair_structure.hpp"
 #include "engine/observables/suspension_averages.hpp"
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/output/sphere_snapshots.hpp"
 #include "engine/placement/random_placement.hpp"
+#include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/stop_signal.hpp"
 
@@ -38,6 +41,26 @@ const std::vector<std::string> kColumns = {
     "step", "time", "stage", "contacts_per_sphere", "mean_aggregate_size", "granular_temperature",
     "Re_T", "kinetic_energy", "well_energy", "collisions"};
 
+std::size_t column(const std::string& name) {
+  const auto it = std::find(kColumns.begin(), kColumns.end(), name);
+  if (it == kColumns.end()) throw std::logic_error("no time-series column " + name);
+  return static_cast<std::size_t>(it - kColumns.begin());
+}
+
+// Microstructure accumulated over the statistics window (paper Fig. 2):
+// g(r) with bins of 0.05a up to 5a (or just under half the box), h(theta)
+// with bins of pi/60 for pairs closer than 3a.
+observables::PairStructure pair_structure_for(const cases::SuspensionCase& c) {
+  const double a = c.radius_cells;
+  const double half_box = 0.5 * std::min({c.box.nx, c.box.ny, c.box.nz});
+  return observables::PairStructure(std::min(5.0 * a, half_box - 0.05 * a), 0.05 * a, 3.0 * a, M_PI / 60);
+}
+
+// Slabs of phi(x, t): one per sphere radius along x.
+int phi_slabs(const cases::SuspensionCase& c) {
+  return std::max(1, static_cast<int>(std::lround(c.box.nx / c.radius_cells)));
+}
+
 // Everything that evolves: what a checkpoint holds.
 struct RunState {
   spheres::SphereSet spheres;
@@ -48,6 +71,8 @@ struct RunState {
   bool stage1_stationary = false;
   std::vector<std::vector<double>> series = std::vector<std::vector<double>>(kColumns.size());
   std::vector<double> size_distribution_sum;  // sum of p(n) over statistics samples
+  observables::PairStructure microstructure{1, 1, 1, 1};
+  std::vector<double> phi_x;                  // phi(x, t): one row of slabs per sample
   double wall_s = 0;                          // before this invocation
 };
 
@@ -83,9 +108,9 @@ std::vector<Vec3> unflatten(const std::vector<double>& v) {
 
 void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const RunState& s,
                       const events::DirectInteractions& contacts, double wall_s) {
-  const fs::path final_path = dir / "checkpoint.h5", tmp = output::temporary_name_for(final_path);
+  output::TemporaryFile tmp(dir / "checkpoint.h5");
   {
-    output::Hdf5File f(tmp, output::Hdf5File::Mode::create);
+    output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
     const hsize_t n = s.spheres.size();
     f.create_group("/spheres");
     f.write("/spheres/position", {n, 3}, flatten(s.spheres.position).data());
@@ -104,6 +129,14 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
     for (std::size_t col = 0; col < kColumns.size(); ++col)
       f.write("/series/" + kColumns[col], {s.series[col].size()}, s.series[col].data());
     f.write("/size_distribution_sum", {s.size_distribution_sum.size()}, s.size_distribution_sum.data());
+    const auto m = s.microstructure.accumulated();
+    f.create_group("/microstructure");
+    f.write("/microstructure/g_counts", {m.g_counts.size()}, m.g_counts.data());
+    f.write("/microstructure/h_counts", {m.h_counts.size()}, m.h_counts.data());
+    f.set_attribute("/microstructure", "g_normalisation", m.g_normalisation);
+    f.set_attribute("/microstructure", "h_pairs", m.h_pairs);
+    f.set_attribute("/microstructure", "configurations", static_cast<std::int64_t>(m.configurations));
+    f.write("/phi_x", {s.phi_x.size()}, s.phi_x.data());
     f.set_attribute("/", "case", c.to_json().dump());
     f.set_attribute("/", "step", static_cast<std::int64_t>(s.step));
     f.set_attribute("/", "stage", static_cast<std::int64_t>(s.stage));
@@ -111,14 +144,15 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
     f.set_attribute("/", "statistics_start", static_cast<std::int64_t>(s.statistics_start));
     f.set_attribute("/", "stage1_stationary", static_cast<std::int64_t>(s.stage1_stationary));
     f.set_attribute("/", "wall_s", wall_s);
+    f.close();
   }
-  output::commit_temporary(tmp, final_path);
+  tmp.commit();
 }
 
 void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunState& s,
                      events::DirectInteractions& contacts) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
-  if (f.attribute_string("/", "case") != c.to_json().dump())
+  if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
     throw input::InputError(file.string() + " belongs to a different case; remove it or use another --out directory");
   s.spheres.position = unflatten(f.read<double>("/spheres/position"));
   s.spheres.velocity = unflatten(f.read<double>("/spheres/velocity"));
@@ -137,6 +171,17 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   counters.steps = static_cast<std::uint64_t>(k[5]);
   for (std::size_t col = 0; col < kColumns.size(); ++col) s.series[col] = f.read<double>("/series/" + kColumns[col]);
   s.size_distribution_sum = f.read<double>("/size_distribution_sum");
+  observables::PairStructure::Accumulated m;
+  m.g_counts = f.read<double>("/microstructure/g_counts");
+  m.h_counts = f.read<double>("/microstructure/h_counts");
+  m.g_normalisation = f.attribute_double("/microstructure", "g_normalisation");
+  m.h_pairs = f.attribute_double("/microstructure", "h_pairs");
+  m.configurations = f.attribute_int("/microstructure", "configurations");
+  s.microstructure.restore(m);
+  s.phi_x = f.read<double>("/phi_x");
+  if (s.spheres.position.size() != static_cast<std::size_t>(c.sphere_count))
+    throw std::runtime_error(file.string() + ": holds " + std::to_string(s.spheres.position.size()) +
+                             " spheres, the case has " + std::to_string(c.sphere_count));
   s.step = f.attribute_int("/", "step");
   s.stage = static_cast<int>(f.attribute_int("/", "stage"));
   s.stage2_start = f.attribute_int("/", "stage2_start");
@@ -148,31 +193,40 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   contacts.set_counters(counters);
 }
 
-void write_series(const fs::path& dir, const RunState& s) {
-  const fs::path final_path = dir / "series.h5", tmp = output::temporary_name_for(final_path);
+void write_series(const fs::path& dir, const RunState& s, int slabs) {
+  output::TemporaryFile tmp(dir / "series.h5");
   {
-    output::Hdf5File f(tmp, output::Hdf5File::Mode::create);
+    output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
     for (std::size_t col = 0; col < kColumns.size(); ++col)
       f.write("/" + kColumns[col], {s.series[col].size()}, s.series[col].data());
+    // phi(x, t): rows are samples (times in /time), columns slabs of width L / slabs
+    const auto slab_count = static_cast<hsize_t>(slabs);
+    f.write("/phi_x", {s.phi_x.size() / slab_count, slab_count}, s.phi_x.data());
+    f.close();
   }
-  output::commit_temporary(tmp, final_path);
+  tmp.commit();
 }
 
 // The samples of one column taken after the statistics started.
-std::vector<double> statistics_window(const RunState& s, const std::string& column) {
+std::vector<double> statistics_window(const RunState& s, const std::string& column_name) {
   const std::size_t step_col = 0;
-  const auto col = static_cast<std::size_t>(std::find(kColumns.begin(), kColumns.end(), column) - kColumns.begin());
+  const std::size_t col = column(column_name);
   std::vector<double> out;
   for (std::size_t k = 0; k < s.series[step_col].size(); ++k)
     if (s.series[step_col][k] > static_cast<double>(s.statistics_start)) out.push_back(s.series[col][k]);
   return out;
 }
 
+// Steady average with its batch-means error over 10 batches (the protocol
+// guarantees at least 20 samples in the window).
 nlohmann::json steady(const std::vector<double>& samples) {
-  const int batches = std::clamp(static_cast<int>(samples.size() / 5), 2, 10);
-  if (samples.size() < 2) return {{"mean", samples.empty() ? NAN : samples[0]}, {"error", NAN}, {"batches", 0}};
-  const auto a = observables::batch_means(samples, batches);
-  return {{"mean", a.mean}, {"error", a.error}, {"batches", a.batches}, {"samples", a.samples}};
+  const auto a = observables::batch_means(samples, 10);
+  return {{"mean", a.mean},
+          {"error", a.error},
+          {"batches", a.batches},
+          {"samples", a.samples},
+          {"correlation_samples", a.correlation_samples},
+          {"error_reliable", a.error_reliable}};
 }
 
 }  // namespace
@@ -186,8 +240,16 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   if (std::find(runnable_sphere_scenes().begin(), runnable_sphere_scenes().end(), c.scene) ==
       runnable_sphere_scenes().end())
     throw input::InputError("scene = \"" + c.scene + "\": must be one of the scenes this build runs: granular, fluid");
-  fs::create_directories(o.out_dir);
+  const StartMode start = prepare_output_directory(o.out_dir, o.resume);
   RunLog log(o.out_dir / "run.log", o.quiet);
+  if (start == StartMode::already_completed) {
+    log.info("already completed: " + (o.out_dir / "result.json").string() + " is kept as it is");
+    RunReport r;
+    r.outcome = RunOutcome::completed;
+    std::ifstream in(o.out_dir / "result.json");
+    r.result = nlohmann::json::parse(in);
+    return r;
+  }
   for (const auto& w : c.warnings) log.warning(w);
   if (c.threads > 0) omp_set_num_threads(c.threads);
   const Clock::time_point t_start = Clock::now();
@@ -204,8 +266,10 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   s.spheres.radius = c.radius_cells;
   s.spheres.density_ratio = c.density_ratio;
   s.size_distribution_sum.assign(static_cast<std::size_t>(c.sphere_count) + 1, 0.0);
+  s.microstructure = pair_structure_for(c);
+  const int slabs = phi_slabs(c);
   const fs::path checkpoint = o.out_dir / "checkpoint.h5";
-  if (o.resume && fs::exists(checkpoint)) {
+  if (start == StartMode::from_checkpoint) {
     read_checkpoint(checkpoint, c, s, contacts);
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(s.step));
   } else {
@@ -233,7 +297,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   Clock::time_point last_checkpoint = Clock::now();
   const long first_step = s.step;
   const double mass = s.spheres.mass();
-  const int signal_column = 5;  // granular_temperature: what must become stationary in stage 1
+  // what must become stationary in stage 1: the granular temperature
+  const std::size_t signal_column = column("granular_temperature");
   bool done = s.statistics_start >= 0 && s.step - s.statistics_start >= d.statistics;
 
   while (!done) {
@@ -259,8 +324,12 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                                        contacts.well_energy(s.spheres),
                                        static_cast<double>(contacts.counters().collisions)};
       for (std::size_t col = 0; col < row.size(); ++col) s.series[col].push_back(row[col]);
-      if (s.statistics_start >= 0)
+      const auto phi = observables::slab_solids_fraction(s.spheres.position, c.radius_cells, box, slabs);
+      s.phi_x.insert(s.phi_x.end(), phi.begin(), phi.end());
+      if (s.statistics_start >= 0) {
         for (std::size_t n = 0; n < agg.size_distribution.size(); ++n) s.size_distribution_sum[n] += agg.size_distribution[n];
+        s.microstructure.add_configuration(s.spheres.position, box);
+      }
       observables_s += seconds_since(t0);
 
       // ---- protocol -----------------------------------------------------------
@@ -286,12 +355,14 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     if (d.snapshot > 0 && (s.step % d.snapshot == 0 || done)) {
       t0 = Clock::now();
       const auto agg = observables::find_aggregates(s.spheres.position, box, 2.0 * (c.radius_cells + c.well_width));
-      output::append_sphere_snapshot(o.out_dir / "spheres.h5", s.step, s.step / c.convective_time, s.spheres,
-                                     agg.aggregate_of);
+      output::write_sphere_snapshot(o.out_dir / "spheres", s.step, s.step / c.convective_time, s.spheres,
+                                    agg.aggregate_of);
       output_s += seconds_since(t0);
     }
     const bool stop_now = stop_requested() != 0 || (o.stop_after_steps > 0 && s.step - first_step >= o.stop_after_steps);
-    if (!done && (stop_now || seconds_since(last_checkpoint) >= c.checkpoint_every_s)) {
+    const bool checkpoint_due = seconds_since(last_checkpoint) >= c.checkpoint_every_s ||
+                                (o.checkpoint_every_steps > 0 && s.step % o.checkpoint_every_steps == 0);
+    if (!done && (stop_now || checkpoint_due)) {
       t0 = Clock::now();
       write_checkpoint(o.out_dir, c, s, contacts, s.wall_s + seconds_since(t_start));
       checkpoint_s += seconds_since(t0);
@@ -307,14 +378,15 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     if (!s.series[0].empty() && s.step % d.sample == 0) {
       char extra[160];
       std::snprintf(extra, sizeof extra, "stage %d | t U/a %.1f | C_sph %.3f | <n_a> %.3f", s.stage,
-                    s.step / c.convective_time, s.series[3].back(), s.series[4].back());
+                    s.step / c.convective_time, s.series[column("contacts_per_sphere")].back(),
+                    s.series[column("mean_aggregate_size")].back());
       progress.update(s.step, extra);
     }
   }
   progress.finish(s.step);
 
   // ---- result.json -------------------------------------------------------------
-  write_series(o.out_dir, s);
+  write_series(o.out_dir, s, slabs);
   nlohmann::json obs;
   obs["contacts_per_sphere"] = steady(statistics_window(s, "contacts_per_sphere"));
   obs["n_a_mean"] = steady(statistics_window(s, "mean_aggregate_size"));
@@ -327,7 +399,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     // with e = 1 and no liquid, kinetic + well energy is conserved
     const double e0 = samples.front() + wells.front(), e1 = samples.back() + wells.back();
     obs["energy_relative_change"] = (e1 - e0) / e0;
-    const double span = (s.step - s.statistics_start) / c.convective_time;
+    const auto times = statistics_window(s, "time");
+    const double span = times.back() - times.front();
     obs["collisions_per_sphere_per_convective_time"] = (collisions.back() - collisions.front()) / c.sphere_count / span;
   }
   std::vector<double> p(s.size_distribution_sum.size());
@@ -335,6 +408,14 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   for (std::size_t n = 0; n < p.size(); ++n) p[n] = n_samples > 0 ? s.size_distribution_sum[n] / n_samples : 0.0;
   while (p.size() > 2 && p.back() == 0.0) p.pop_back();
   obs["size_distribution"] = p;
+  {
+    std::vector<double> r = s.microstructure.radial_bin_centres(), theta = s.microstructure.angular_bin_centres();
+    for (double& x : r) x /= c.radius_cells;
+    obs["g_r"] = {{"r_over_a", r}, {"g", s.microstructure.radial_distribution()}};
+    obs["h_theta"] = {{"theta", theta}, {"h", s.microstructure.angular_distribution()},
+                      {"pairs_closer_than", "3a"}};
+    obs["microstructure_configurations"] = s.microstructure.configurations();
+  }
   obs["window"] = {{"start", s.statistics_start / c.convective_time},
                    {"end", s.step / c.convective_time},
                    {"unit", "a/U_inf"},

@@ -31,12 +31,14 @@ TEST(SuspensionCase, PaperDomainGivesThePapersSphereCounts) {
   // gives 792 / 1320 / 1650 / 2112: the paper's counts correspond to phi
   // rounded to two digits, so agreement to 0.5 % is what can be asked.
   const double paper_n[] = {790, 1320, 1645, 2112};
+  const int rounded_n[] = {792, 1320, 1650, 2112};  // round(phi * 6600.5), by hand
   const double phis[] = {0.12, 0.20, 0.25, 0.32};
   for (int k = 0; k < 4; ++k) {
     const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", phis[k]}});
     EXPECT_EQ(c.box.nx, 288);
     EXPECT_EQ(c.box.ny, 144);
     EXPECT_EQ(c.box.nz, 144);
+    EXPECT_EQ(c.sphere_count, rounded_n[k]) << "phi = " << phis[k];
     EXPECT_NEAR(c.sphere_count / paper_n[k], 1.0, 0.005) << "phi = " << phis[k];
     EXPECT_NEAR(c.phi_realised, phis[k], 0.5 / 6600.5);  // within half a sphere
   }
@@ -57,6 +59,10 @@ TEST(SuspensionCase, LatticeUnitsByHand) {
 }
 
 TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
+  // Hand-worked for the paper box at phi = 0.20 (N = 1320, phi_realised =
+  // 1320 / 6600.5), Re_inf = 12, U = 0.02: f = phi (rho_p - rho) g.
+  const SuspensionCase p = parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
+  EXPECT_NEAR(p.liquid_body_force, (1320 / (27648 / (4 * M_PI / 3))) * 3 * p.gravity, 1e-18);
   // SPEC section 1: f V (1 - phi) = N (rho_p - rho_bar) (4/3) pi a^3 g.
   const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.25}, {"Re_inf", 24}});
   const double volume = static_cast<double>(c.box.cells());

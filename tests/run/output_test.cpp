@@ -30,10 +30,9 @@ TEST(AtomicFile, ReplacesContentWithoutLeavingTemporaries) {
   fs::remove_all(dir);
 }
 
-TEST(FieldSnapshots, ReadBackExactlyWithXdmfIndex) {
+TEST(FieldSnapshots, OneCompleteFilePerSnapshotWithXdmfIndex) {
   const fs::path dir = fs::temp_directory_path() / ("flocsim_fields_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  fs::create_directories(dir);
   const int nx = 5, ny = 3, nz = 2;
   std::vector<double> rho(nx * ny * nz), ux(rho.size()), uy(rho.size()), uz(rho.size());
   for (std::size_t i = 0; i < rho.size(); ++i) {
@@ -42,17 +41,40 @@ TEST(FieldSnapshots, ReadBackExactlyWithXdmfIndex) {
     uy[i] = -0.2 * i;
     uz[i] = 1.0 / (1 + i);
   }
-  append_field_snapshot(dir / "fields.h5", {10, nx, ny, nz, &rho, &ux, &uy, &uz});
-  append_field_snapshot(dir / "fields.h5", {20, nx, ny, nz, &rho, &ux, &uy, &uz});
-  EXPECT_EQ(snapshot_steps(dir / "fields.h5"), (std::vector<long>{10, 20}));
+  write_field_snapshot(dir / "fields", {10, nx, ny, nz, &rho, &ux, &uy, &uz});
+  write_field_snapshot(dir / "fields", {20, nx, ny, nz, &rho, &ux, &uy, &uz});
+  // a temporary left by a killed writer is not a snapshot
+  std::ofstream(dir / "fields" / ".step_0000000030.h5.tmp.1") << "partial";
+  EXPECT_EQ(snapshot_steps(dir / "fields"), (std::vector<long>{10, 20}));
   std::vector<hsize_t> shape;
-  const auto back = Hdf5File(dir / "fields.h5", Hdf5File::Mode::read).read<double>("/step_0000000020/velocity_z", &shape);
+  const auto back = Hdf5File(snapshot_file(dir / "fields", 20), Hdf5File::Mode::read).read<double>("/velocity_z", &shape);
   EXPECT_EQ(shape, (std::vector<hsize_t>{2, 3, 5}));  // [nz][ny][nx]
   EXPECT_EQ(back, uz);
   std::stringstream x;
   x << std::ifstream(dir / "fields.xdmf").rdbuf();
-  EXPECT_NE(x.str().find("fields.h5:/step_0000000010/density"), std::string::npos);
-  EXPECT_NE(x.str().find("fields.h5:/step_0000000020/velocity_x"), std::string::npos);
+  EXPECT_NE(x.str().find("fields/step_0000000010.h5:/density"), std::string::npos);
+  EXPECT_NE(x.str().find("fields/step_0000000020.h5:/velocity_x"), std::string::npos);
+  EXPECT_EQ(x.str().find("0000000030"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(TemporaryFile, AnAbandonedWriteLeavesThePreviousFileAndNoDebris) {
+  const fs::path dir = fs::temp_directory_path() / ("flocsim_tmpfile_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_file_atomically(dir / "checkpoint.h5", "good");
+  try {
+    TemporaryFile tmp(dir / "checkpoint.h5");
+    std::ofstream(tmp.path()) << "half written";
+    throw std::runtime_error("disk full");  // the writer fails before commit()
+  } catch (const std::runtime_error&) {
+  }
+  std::stringstream s;
+  s << std::ifstream(dir / "checkpoint.h5").rdbuf();
+  EXPECT_EQ(s.str(), "good");
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1);
   fs::remove_all(dir);
 }
 

@@ -1,0 +1,24 @@
+#pragma once
+// What a run finds in its output directory decides how it starts:
+//   - result.json present: the run is complete; --resume leaves it alone, a
+//     fresh start refuses to overwrite it;
+//   - checkpoint.h5 present: --resume continues from it, a fresh start
+//     refuses (it would silently discard the work);
+//   - otherwise a fresh start, after removing snapshot output an earlier,
+//     never-checkpointed attempt may have left.
+// Refusals are input errors naming the file and the way out.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+namespace flocsim::run {
+
+enum class StartMode { fresh, from_checkpoint, already_completed };
+
+StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume);
+
+// A checkpoint may be continued under a case that differs only in run
+// control (threads, progress and checkpoint cadence; for the fluid scene the
+// total number of steps, to extend a run). Everything else must match.
+bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json& current_case);
+
+}  // namespace flocsim::run
