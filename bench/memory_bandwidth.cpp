@@ -1,12 +1,15 @@
 #include "bench/memory_bandwidth.hpp"
 
+#if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+#endif
 #include <omp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 
 namespace flocsim::bench {
 
@@ -38,6 +41,7 @@ inline void store_fence() {
 
 double* alloc(std::size_t n) {
   auto* p = static_cast<double*>(std::aligned_alloc(4096, (n * sizeof(double) + 4095) / 4096 * 4096));
+  if (!p) throw std::bad_alloc();
   return p;
 }
 

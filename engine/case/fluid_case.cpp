@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <sstream>
 
+#include "engine/case/case_support.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -37,17 +38,6 @@ double cell_noise(unsigned seed, long cell, int component) {
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 
-std::string format(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
-
-double physical_memory_bytes() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
-}
 
 }  // namespace
 
@@ -63,16 +53,16 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const auto size = fluid.numbers("size", 3, {.at_least = 1, .at_most = 4096});
   for (int d = 0; d < 3; ++d)
     if (size[d] != std::floor(size[d]))
-      throw InputError(fluid.field("size") + "[" + std::to_string(d) + "] = " + format(size[d]) +
+      throw InputError(fluid.field("size") + "[" + std::to_string(d) + "] = " + format_value(size[d]) +
                        ": must be a whole number of cells");
   c.size = {static_cast<int>(size[0]), static_cast<int>(size[1]), static_cast<int>(size[2])};
   c.relaxation.viscosity = fluid.number(
       "viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
   c.relaxation.magic_lambda = fluid.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
   if (c.relaxation.viscosity < kSmallestTestedViscosity)
-    c.warnings.push_back(fluid.field("viscosity") + " = " + format(c.relaxation.viscosity) +
+    c.warnings.push_back(fluid.field("viscosity") + " = " + format_value(c.relaxation.viscosity) +
                          " is below the smallest viscosity the solver is tested at (" +
-                         format(kSmallestTestedViscosity) + ", tau = 0.515)");
+                         format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
   const Range force_range{.at_least = -0.01, .at_most = 0.01};
   const auto f = fluid.numbers("body_force", 3, force_range, std::vector<double>{0, 0, 0});
   c.body_force = {f[0], f[1], f[2]};
@@ -141,17 +131,17 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const double peak = mean + wave_peak + std::sqrt(3.0) * in.noise;
   if (peak > kMaxLatticeSpeed)
     throw InputError("fluid.initial: peak initial speed |velocity| + wave peak + sqrt(3) noise = " +
-                     format(peak) + ": must be <= " + format(kMaxLatticeSpeed) +
+                     format_value(peak) + ": must be <= " + format_value(kMaxLatticeSpeed) +
                      " (Mach limit |u| <= 0.2 c_s)");
   // A uniform body force in a fully periodic box accelerates the mean flow
   // without bound (nothing balances it): u_mean(t) = u_mean(0) + f t / rho.
   const double fmag = std::hypot(c.body_force.x, c.body_force.y, c.body_force.z);
   const double final_mean = mean + fmag * static_cast<double>(c.run.steps);
   if (fmag > 0 && final_mean > kMaxLatticeSpeed)
-    throw InputError("fluid.body_force = [" + format(c.body_force.x) + ", " + format(c.body_force.y) +
-                     ", " + format(c.body_force.z) + "]: accelerates the mean flow to |u| = " +
-                     format(final_mean) + " after run.steps = " + std::to_string(c.run.steps) +
-                     "; must stay <= " + format(kMaxLatticeSpeed) +
+    throw InputError("fluid.body_force = [" + format_value(c.body_force.x) + ", " + format_value(c.body_force.y) +
+                     ", " + format_value(c.body_force.z) + "]: accelerates the mean flow to |u| = " +
+                     format_value(final_mean) + " after run.steps = " + std::to_string(c.run.steps) +
+                     "; must stay <= " + format_value(kMaxLatticeSpeed) +
                      " (Mach limit |u| <= 0.2 c_s; a periodic box has nothing to balance it)");
   // Memory: 19 populations per cell in the chosen precision.
   const double bytes = static_cast<double>(c.size.cells()) * 19.0 *
@@ -159,9 +149,9 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const double available = physical_memory_bytes();
   if (available > 0 && bytes > 0.8 * available)
     throw InputError("fluid.size = [" + std::to_string(c.size.nx) + ", " + std::to_string(c.size.ny) +
-                     ", " + std::to_string(c.size.nz) + "]: needs " + format(bytes / 1e9) +
+                     ", " + std::to_string(c.size.nz) + "]: needs " + format_value(bytes / 1e9) +
                      " GB for the populations; must fit in 80 % of this machine's " +
-                     format(available / 1e9) + " GB");
+                     format_value(available / 1e9) + " GB");
   return c;
 }
 

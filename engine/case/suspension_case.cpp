@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "engine/case/fluid_case.hpp"
+#include "engine/case/case_support.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -16,12 +17,6 @@ using input::Range;
 
 namespace {
 
-std::string format(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 
 // Resolution, domain and durations of each fidelity preset. The paper preset
 // is the paper's default case (a = 6 dx, L = 48a, L/W = 2); standard keeps
@@ -89,12 +84,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
   num.finish();
   if (c.settling_velocity > kMaxSettlingVelocity)
-    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format(c.reynolds_inf) + " * " + format(c.viscosity) +
-                     " / " + format(2 * a) + " = " + format(c.settling_velocity) + ": must be <= " +
-                     format(kMaxSettlingVelocity) + " (Mach limit for settling flows); lower numerics.viscosity");
+    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) + " * " + format_value(c.viscosity) +
+                     " / " + format_value(2 * a) + " = " + format_value(c.settling_velocity) + ": must be <= " +
+                     format_value(kMaxSettlingVelocity) + " (Mach limit for settling flows); lower numerics.viscosity");
   if (c.viscosity < kSmallestTestedViscosity)
-    c.warnings.push_back("viscosity = " + format(c.viscosity) + " is below the smallest tested (" +
-                         format(kSmallestTestedViscosity) + ", tau = 0.515)");
+    c.warnings.push_back("viscosity = " + format_value(c.viscosity) + " is below the smallest tested (" +
+                         format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
 
   InputReader pr = root.object("protocol");
   const Range duration{.at_least = 0, .at_most = 1e5};
@@ -112,8 +107,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
   pr.finish();
   if (c.statistics < 20 * c.sample_every)
-    throw InputError("protocol.statistics = " + format(c.statistics) + ": must be >= 20 x protocol.sample_every = " +
-                     format(20 * c.sample_every) + " (10 batch means of at least 2 samples each)");
+    throw InputError("protocol.statistics = " + format_value(c.statistics) + ": must be >= 20 x protocol.sample_every = " +
+                     format_value(20 * c.sample_every) + " (10 batch means of at least 2 samples each)");
   root.finish();
 
   // ---- lattice-unit quantities (SPEC section 2) -----------------------------
@@ -124,14 +119,14 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   // well and event ranges, 2(a + delta) plus a skin, are shorter): that must
   // stay below half the box so that a pair has one periodic image only.
   if (W <= 6 * a)
-    throw InputError("L_over_W = " + format(c.length_over_width) + " with L_over_a = " + format(c.length_over_a) +
-                     ": makes the box width W = " + std::to_string(W) + " cells; must exceed 6a = " + format(6 * a) +
+    throw InputError("L_over_W = " + format_value(c.length_over_width) + " with L_over_a = " + format_value(c.length_over_a) +
+                     ": makes the box width W = " + std::to_string(W) + " cells; must exceed 6a = " + format_value(6 * a) +
                      " so that pairs within 3a have a single periodic image");
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
   c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));
   if (c.sphere_count < 1)
-    throw InputError("phi = " + format(c.phi) + ": gives N = 0 spheres in this box; raise phi or L_over_a");
+    throw InputError("phi = " + format_value(c.phi) + ": gives N = 0 spheres in this box; raise phi or L_over_a");
   c.phi_realised = c.sphere_count * sphere_volume / volume;
   if (single) c.phi = c.phi_realised;
 
@@ -146,11 +141,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.sphere_net_gravity = (1.0 - c.phi_realised) * (c.density_ratio - 1.0) * sphere_volume * c.gravity;
 
   const double bytes = static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
-  const double available = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  const double available = physical_memory_bytes();
   if (c.scene != "granular" && available > 0 && bytes > 0.8 * available)
-    throw InputError("L_over_a = " + format(c.length_over_a) + ", a_over_dx = " + format(a) + ": the " +
+    throw InputError("L_over_a = " + format_value(c.length_over_a) + ", a_over_dx = " + format_value(a) + ": the " +
                      std::to_string(L) + " x " + std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
-                     format(bytes / 1e9) + " GB; must fit in 80 % of this machine's " + format(available / 1e9) + " GB");
+                     format_value(bytes / 1e9) + " GB; must fit in 80 % of this machine's " + format_value(available / 1e9) + " GB");
   return c;
 }
 

@@ -8,6 +8,16 @@
 #include <stdexcept>
 #include <string>
 
+// The collision must be inlined into the vectorised row loop; GCC and Clang
+// need telling, other compilers get plain inline.
+#if defined(__GNUC__)
+#define FLOCSIM_ALWAYS_INLINE inline __attribute__((always_inline))
+#define FLOCSIM_LAMBDA_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define FLOCSIM_ALWAYS_INLINE inline
+#define FLOCSIM_LAMBDA_ALWAYS_INLINE
+#endif
+
 namespace flocsim::lattice {
 
 using namespace d3q19;
@@ -34,7 +44,7 @@ struct CollisionConstants {
 // TRT collision with Guo forcing, on the deviations f_i - w_i of one cell, in
 // place. F is the force density acting on the cell.
 template <class Real>
-inline __attribute__((always_inline)) void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
+FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
                                                    const CollisionConstants<Real>& k) {
   Real drho = 0;
 #pragma GCC unroll 19
@@ -127,9 +137,11 @@ void FluidLattice<Real>::enable_force_field() {
   force_x_ = allocate(cells);
   force_y_ = allocate(cells);
   force_z_ = allocate(cells);
-  std::memset(force_x_.get(), 0, cells * sizeof(Real));
-  std::memset(force_y_.get(), 0, cells * sizeof(Real));
-  std::memset(force_z_.get(), 0, cells * sizeof(Real));
+  // first touch in the kernel's static schedule, as for the populations
+  Real* const f[3] = {force_x_.get(), force_y_.get(), force_z_.get()};
+  const long n = static_cast<long>(cells);
+#pragma omp parallel for schedule(static)
+  for (long c = 0; c < n; ++c) f[0][c] = f[1][c] = f[2][c] = Real(0);
 }
 
 template <class Real>
@@ -383,7 +395,7 @@ void FluidLattice<Real>::step_kernel() {
       const Real* Fz = kForceField ? Fzs + row : nullptr;
 
       auto update = [&](int x, const Real* const* ld, Real* const* st, int lx, int sx)
-                        __attribute__((always_inline)) {
+                        FLOCSIM_LAMBDA_ALWAYS_INLINE {
         Real f[kQ];
 #pragma GCC unroll 19
         for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
