@@ -1,5 +1,6 @@
 #include "orchestrator/slurm_backend.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,7 +27,7 @@ namespace {
 // exit code, or -1 when it could not be run.
 int run_program(const std::vector<std::string>& argv, std::string* output) {
   int pipe_fd[2];
-  if (pipe(pipe_fd) != 0) return -1;
+  if (pipe2(pipe_fd, O_CLOEXEC) != 0) return -1;  // daemons must not inherit it
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);

@@ -42,7 +42,7 @@ int decode(int status) {
 
 Output run(const std::vector<std::string>& argv, const std::vector<std::string>& env) {
   int fds[2];
-  if (pipe(fds) != 0) return {};
+  if (pipe2(fds, O_CLOEXEC) != 0) return {};  // only the dup2 copies reach the child
   const pid_t pid = spawn_to(argv, env, fds[1]);
   close(fds[1]);
   Output o;
@@ -57,7 +57,7 @@ Output run(const std::vector<std::string>& argv, const std::vector<std::string>&
 }
 
 Background start(const std::vector<std::string>& argv, const std::string& log) {
-  const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   Background b;
   b.pid = spawn_to(argv, {}, fd);
   b.log = log;
