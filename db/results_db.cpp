@@ -1,5 +1,7 @@
 #include "db/results_db.hpp"
 
+#include <filesystem>
+
 #include <sqlite3.h>
 #include <unistd.h>
 
@@ -186,6 +188,12 @@ class ResultsDb::Statement {
 };
 
 ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pid_(getpid()) {
+  if (mode == Mode::kCreate) {
+    // a new database may live in a folder that does not exist yet (runs/x.sqlite)
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  }
   const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX |
                     (mode == Mode::kCreate ? SQLITE_OPEN_CREATE : 0);
   const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);

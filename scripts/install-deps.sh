@@ -10,9 +10,10 @@ packages=(
   nlohmann-json3-dev libgtest-dev libgmock-dev libcli11-dev
   gnuplot-nox
 )
-# Optional extras, requested with FLOCSIM_WITH_SLURM=1: a single-node Slurm
-# used by the orchestrator's Slurm-backend tests.
-if [[ "${FLOCSIM_WITH_SLURM:-0}" == 1 ]]; then
+# Slurm, the orchestrator's backend for sweeps that outgrow one machine; the
+# tests start a private single-node Slurm from these packages. Skip them with
+# FLOCSIM_WITH_SLURM=0 (the Slurm tests then skip with a message).
+if [[ "${FLOCSIM_WITH_SLURM:-1}" == 1 ]]; then
   packages+=(slurmctld slurmd slurm-client munge)
 fi
 

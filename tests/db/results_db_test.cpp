@@ -79,6 +79,17 @@ TEST_F(DbTest, NewDatabaseHasCurrentSchemaInWalMode) {
   EXPECT_EQ(db.runs().size(), 2u);
 }
 
+TEST_F(DbTest, CreatesTheFolderOfANewDatabase) {
+  // `flocsim sweep launch --db runs/demo.sqlite` on a fresh checkout: the
+  // folder does not exist yet and is made; an existing database is never
+  // created silently.
+  const std::string nested = (dir_ / "runs" / "deeper" / "demo.sqlite").string();
+  { ResultsDb db(nested, ResultsDb::Mode::kCreate); }
+  EXPECT_TRUE(fs::exists(nested));
+  EXPECT_THROW(ResultsDb((dir_ / "absent" / "x.sqlite").string(), ResultsDb::Mode::kExisting), DbError);
+  EXPECT_FALSE(fs::exists(dir_ / "absent"));
+}
+
 TEST_F(DbTest, RefusesMissingForeignAndNewerFiles) {
   EXPECT_THROW(ResultsDb(path_, ResultsDb::Mode::kExisting), DbError);
   EXPECT_FALSE(fs::exists(path_));
