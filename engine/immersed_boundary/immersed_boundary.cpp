@@ -178,6 +178,17 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   for (auto& w : workspaces_)
     if (!w) w = std::make_unique<Workspace>(B, markers);
 
+  const double ball = 4.0 / 3.0 * M_PI * std::pow(ag + 2.6, 3);
+  const bool use_field = static_cast<double>(n) * ball > 0.25 * static_cast<double>(e.cells());
+  if (use_field) {
+    const std::size_t cells = static_cast<std::size_t>(e.cells());
+    field_rho_.resize(cells);
+    field_ux_.resize(cells);
+    field_uy_.resize(cells);
+    field_uz_.resize(cells);
+    fluid.macroscopic_field_without_force_field(field_rho_.data(), field_ux_.data(),
+                                                field_uy_.data(), field_uz_.data());
+  }
   std::vector<double> slip_sq(settings_.measure_slip ? n : 0),
       slip_max(settings_.measure_slip ? n : 0);
   Real* field[3] = {fluid.force_field(0), fluid.force_field(1), fluid.force_field(2)};
@@ -211,6 +222,18 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
         const int gz = ws.global[2][static_cast<std::size_t>(k)];
         const int row = B * (j + B * k);
         for (int i = i0; i <= i1; ++i) ws.touched.push_back(row + i);
+        if (use_field) {
+          const long grow = fluid.cell_index(0, gy, gz);
+          for (int i = i0; i <= i1; ++i) {
+            const long g = grow + ws.global[0][static_cast<std::size_t>(i)];
+            const std::size_t lc = static_cast<std::size_t>(row + i);
+            ws.rho[lc] = field_rho_[static_cast<std::size_t>(g)];
+            ws.ux[lc] = field_ux_[static_cast<std::size_t>(g)];
+            ws.uy[lc] = field_uy_[static_cast<std::size_t>(g)];
+            ws.uz[lc] = field_uz_[static_cast<std::size_t>(g)];
+          }
+          continue;
+        }
         // Read the row in pieces that do not cross the periodic edge in x.
         for (int i = i0; i <= i1;) {
           const int gx = ws.global[0][static_cast<std::size_t>(i)];

@@ -123,6 +123,10 @@ class ImmersedBoundary {
   std::vector<std::array<int, 3>> origins_;  // lowest corner of each sphere's cell box (unwrapped)
   std::vector<std::array<int, 3>> written_;  // boxes holding force from the last apply()
   std::vector<std::unique_ptr<Workspace>> workspaces_;
+  // u* of every cell, filled by one streaming pass when the spheres' cell
+  // balls cover more than a quarter of the lattice (dense suspensions);
+  // otherwise each sphere reads its own cells from the populations.
+  std::vector<Real> field_rho_, field_ux_, field_uy_, field_uz_;
   double rms_slip_ = 0, max_slip_ = 0;
 };
 

@@ -276,6 +276,60 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
 }
 
 template <class Real>
+void FluidLattice<Real>::macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy,
+                                                               Real* uz) const {
+  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
+  const bool even = time_step_ % 2 == 0;
+  const Real bx = static_cast<Real>(0.5 * body_force_.x);
+  const Real by = static_cast<Real>(0.5 * body_force_.y);
+  const Real bz = static_cast<Real>(0.5 * body_force_.z);
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+      const Real* p[kQ];
+      for (int i = 0; i < kQ; ++i) {
+        if (even) {
+          p[i] = storage(i) + row;
+        } else {
+          const long up = static_cast<long>(nx) *
+                          (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
+          p[i] = storage(opposite(i)) + up - cx[i];
+        }
+      }
+      Real* const r = density + row;
+      Real* const vx = ux + row;
+      Real* const vy = uy + row;
+      Real* const vz = uz + row;
+      const int x_begin = even ? 0 : 1;
+      const int x_end = even ? nx : nx - 1;
+#pragma omp simd
+      for (int x = x_begin; x < x_end; ++x) {
+        Real f[kQ];
+        for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
+        Real drho = 0;
+        for (int i = 0; i < kQ; ++i) drho += f[i];
+        const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
+        const Real jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
+        const Real jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
+        const Real rho = Real(1) + drho, inv = Real(1) / rho;
+        r[x] = rho;
+        vx[x] = (jx + bx) * inv;
+        vy[x] = (jy + by) * inv;
+        vz[x] = (jz + bz) * inv;
+      }
+      if (!even)
+        for (int x : {0, nx - 1}) {
+          const Macroscopic m = macroscopic_without_force_field(x, y, z);
+          r[x] = static_cast<Real>(m.density);
+          vx[x] = static_cast<Real>(m.velocity.x);
+          vy[x] = static_cast<Real>(m.velocity.y);
+          vz[x] = static_cast<Real>(m.velocity.z);
+        }
+    }
+}
+
+template <class Real>
 void FluidLattice<Real>::macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,
                                             std::vector<double>& uy,
                                             std::vector<double>& uz) const {

@@ -92,6 +92,9 @@ class FluidLattice {
   // (inside the box, no wrap in x), written to density[k], ux[k], uy[k], uz[k].
   void macroscopic_row_without_force_field(int x0, int count, int y, int z, double* density,
                                            double* ux, double* uy, double* uz) const;
+  // The same for every cell, in one streaming pass over the populations
+  // (threads over rows), into arrays of length cells() indexed by cell_index.
+  void macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy, Real* uz) const;
 
   // Density and velocity of every cell (arrays of length cells(), x fastest).
   void macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
@@ -66,6 +67,20 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
                       full.velocity.y - 0.5 * fluid.force_field(1)[c] / full.density, 1e-15);
           EXPECT_NEAR(bare.velocity.z,
                       full.velocity.z - 0.5 * fluid.force_field(2)[c] / full.density, 1e-15);
+        }
+    // The whole-field reader too.
+    const std::size_t cells = static_cast<std::size_t>(fluid.extent().cells());
+    std::vector<double> fr(cells), fx(cells), fy(cells), fz(cells);
+    fluid.macroscopic_field_without_force_field(fr.data(), fx.data(), fy.data(), fz.data());
+    for (int z = 0; z < 6; ++z)
+      for (int y = 0; y < 7; ++y)
+        for (int x = 0; x < 9; ++x) {
+          const auto bare = fluid.macroscopic_without_force_field(x, y, z);
+          const auto c = static_cast<std::size_t>(fluid.cell_index(x, y, z));
+          EXPECT_NEAR(fr[c], bare.density, 1e-15);
+          EXPECT_NEAR(fx[c], bare.velocity.x, 1e-15);
+          EXPECT_NEAR(fy[c], bare.velocity.y, 1e-15);
+          EXPECT_NEAR(fz[c], bare.velocity.z, 1e-15);
         }
     // The row reader gives the same numbers, edge cells included.
     double rho[9], ux[9], uy[9], uz[9];
