@@ -28,9 +28,9 @@ struct KernelFigure {
   std::string precision;
   bool force_field;
   int threads;
-  double mlups;           // median over repetitions
-  double bandwidth;       // median of the best memory-probe figure, bytes/s
-  double fraction;        // median over repetitions of MLUPS / roofline MLUPS
+  double mlups;      // median over repetitions
+  double bandwidth;  // median of the best memory-probe figure, bytes/s
+  double fraction;   // median over repetitions of MLUPS / roofline MLUPS
   double bytes_per_cell;
 };
 
@@ -73,8 +73,13 @@ KernelFigure time_kernel(int n, int threads, bool force_field, int steps, int re
     std::fprintf(stderr, "bench_fluid: non-finite velocity, kernel broken\n");
     std::exit(1);
   }
-  return {sizeof(Real) == 8 ? "double" : "float", force_field, threads, bench::median(rates),
-          bench::median(bandwidths), bench::median(fractions), bytes};
+  return {sizeof(Real) == 8 ? "double" : "float",
+          force_field,
+          threads,
+          bench::median(rates),
+          bench::median(bandwidths),
+          bench::median(fractions),
+          bytes};
 }
 
 }  // namespace
@@ -91,17 +96,25 @@ int main(int argc, char** argv) {
       }
       return std::string(argv[++a]);
     };
-    if (arg == "--size") n = std::stoi(next());
-    else if (arg == "--reps") reps = std::stoi(next());
-    else if (arg == "--steps") steps = std::stoi(next());
-    else if (arg == "--json") json_path = next();
-    else if (arg == "--threads") only_threads = std::stoi(next());
-    else if (arg == "--precision") only_precision = next();
-    else if (arg == "--forcing") only_forcing = next();
+    if (arg == "--size")
+      n = std::stoi(next());
+    else if (arg == "--reps")
+      reps = std::stoi(next());
+    else if (arg == "--steps")
+      steps = std::stoi(next());
+    else if (arg == "--json")
+      json_path = next();
+    else if (arg == "--threads")
+      only_threads = std::stoi(next());
+    else if (arg == "--precision")
+      only_precision = next();
+    else if (arg == "--forcing")
+      only_forcing = next();
     else {
-      std::fprintf(stderr, "usage: bench_fluid [--size N] [--reps R] [--steps S] [--json FILE]\n"
-                           "                   [--threads T] [--precision double|float|all]\n"
-                           "                   [--forcing uniform|per-cell|all]\n");
+      std::fprintf(stderr,
+                   "usage: bench_fluid [--size N] [--reps R] [--steps S] [--json FILE]\n"
+                   "                   [--threads T] [--precision double|float|all]\n"
+                   "                   [--forcing uniform|per-cell|all]\n");
       return 2;
     }
   }
@@ -110,7 +123,8 @@ int main(int argc, char** argv) {
   if (max_threads > 1) thread_counts.push_back(max_threads);
   if (only_threads > 0) thread_counts = {only_threads};
 
-  std::printf("flocsim fluid benchmark: %d^3 periodic box, D3Q19 TRT + Guo forcing, AA pattern\n", n);
+  std::printf("flocsim fluid benchmark: %d^3 periodic box, D3Q19 TRT + Guo forcing, AA pattern\n",
+              n);
   std::printf("median of %d repetitions of %d steps each\n\n", reps, steps);
 
   nlohmann::json out;
@@ -138,11 +152,14 @@ int main(int argc, char** argv) {
         std::printf("%-9s %-12s %8d %10.1f %11.0f %10.1f %14.1f %8.0f%%\n", k.precision.c_str(),
                     ff ? "per-cell" : "uniform", k.threads, k.mlups, k.bytes_per_cell,
                     k.bandwidth / 1e9, roof, 100 * k.fraction);
-        out["kernel"].push_back({{"precision", k.precision}, {"force_field", ff},
-                                 {"threads", k.threads}, {"MLUPS", k.mlups},
+        out["kernel"].push_back({{"precision", k.precision},
+                                 {"force_field", ff},
+                                 {"threads", k.threads},
+                                 {"MLUPS", k.mlups},
                                  {"bytes_per_cell", k.bytes_per_cell},
                                  {"roofline_GBps", k.bandwidth / 1e9},
-                                 {"roofline_MLUPS", roof}, {"fraction", k.fraction}});
+                                 {"roofline_MLUPS", roof},
+                                 {"fraction", k.fraction}});
       }
   if (!json_path.empty()) std::ofstream(json_path) << out.dump(2) << "\n";
   return 0;

@@ -40,7 +40,8 @@ inline void store_fence() {
 }
 
 double* alloc(std::size_t n) {
-  auto* p = static_cast<double*>(std::aligned_alloc(4096, (n * sizeof(double) + 4095) / 4096 * 4096));
+  auto* p =
+      static_cast<double*>(std::aligned_alloc(4096, (n * sizeof(double) + 4095) / 4096 * 4096));
   if (!p) throw std::bad_alloc();
   return p;
 }

@@ -1,11 +1,10 @@
 #include "db/results_db.hpp"
 
-#include <filesystem>
-
 #include <sqlite3.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <map>
 #include <utility>
 

@@ -31,7 +31,8 @@ int run_command(const RunArguments& a) {
   bool fluid_scene = false;
   try {
     const nlohmann::json document = input::read_json_file(a.case_file);
-    const nlohmann::json* scene = document.is_object() && document.contains("scene") ? &document["scene"] : nullptr;
+    const nlohmann::json* scene =
+        document.is_object() && document.contains("scene") ? &document["scene"] : nullptr;
     fluid_scene = scene && scene->is_string() && scene->get<std::string>() == "fluid";
     if (fluid_scene) {
       fluid_case = cases::parse_fluid_case(document);
@@ -41,7 +42,8 @@ int run_command(const RunArguments& a) {
       if (std::find(runnable.begin(), runnable.end(), sphere_case.scene) == runnable.end()) {
         std::string list = "\"fluid\"";
         for (const auto& r : runnable) list += ", \"" + r + "\"";
-        throw input::InputError("scene = \"" + sphere_case.scene + "\": this build runs scenes " + list);
+        throw input::InputError("scene = \"" + sphere_case.scene + "\": this build runs scenes " +
+                                list);
       }
     }
   } catch (const input::InputError& e) {
@@ -56,14 +58,17 @@ int run_command(const RunArguments& a) {
   options.stop_after_steps = a.stop_after_steps;
   run::RunReport report;
   try {
-    report = fluid_scene ? run::run_fluid_case(fluid_case, options) : run::run_sphere_case(sphere_case, options);
+    report = fluid_scene ? run::run_fluid_case(fluid_case, options)
+                         : run::run_sphere_case(sphere_case, options);
   } catch (const input::InputError& e) {
     std::fprintf(stderr, "flocsim run: input error: %s\n", e.what());
     return kExitBadInput;
   }
   switch (report.outcome) {
-    case run::RunOutcome::completed: return kExitOk;
-    case run::RunOutcome::interrupted: return kExitInterrupted;
+    case run::RunOutcome::completed:
+      return kExitOk;
+    case run::RunOutcome::interrupted:
+      return kExitInterrupted;
     case run::RunOutcome::failed:
       std::fprintf(stderr, "flocsim run: failed: %s\n", report.message.c_str());
       return kExitFailure;
@@ -74,7 +79,9 @@ int run_command(const RunArguments& a) {
 const bool registered = register_command(
     {"run", "Run one simulation case (also the orchestrator's worker)", [](CLI::App& cmd) {
        auto args = std::make_shared<RunArguments>();
-       cmd.add_option("case", args->case_file, "Case file (JSON)")->required()->check(CLI::ExistingFile);
+       cmd.add_option("case", args->case_file, "Case file (JSON)")
+           ->required()
+           ->check(CLI::ExistingFile);
        cmd.add_option("--out,-o", args->out_dir, "Output directory")->required();
        cmd.add_flag("--resume", args->resume, "Continue from OUT/checkpoint.h5 if it exists");
        cmd.add_flag("--quiet,-q", args->quiet, "Write only the log file, nothing on stderr");

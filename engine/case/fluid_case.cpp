@@ -20,7 +20,9 @@ namespace {
 
 const char* kAxisNames[3] = {"x", "y", "z"};
 
-int axis_index(const std::string& s) { return s == "x" ? 0 : s == "y" ? 1 : 2; }
+int axis_index(const std::string& s) {
+  return s == "x" ? 0 : s == "y" ? 1 : 2;
+}
 
 int extent_along(const lattice::Extent& e, int axis) {
   return axis == 0 ? e.nx : axis == 1 ? e.ny : e.nz;
@@ -38,7 +40,6 @@ double cell_noise(unsigned seed, long cell, int component) {
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 
-
 }  // namespace
 
 FluidCase parse_fluid_case(const nlohmann::json& document) {
@@ -53,8 +54,8 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const auto size = fluid.numbers("size", 3, {.at_least = 1, .at_most = 4096});
   for (int d = 0; d < 3; ++d)
     if (size[d] != std::floor(size[d]))
-      throw InputError(fluid.field("size") + "[" + std::to_string(d) + "] = " + format_value(size[d]) +
-                       ": must be a whole number of cells");
+      throw InputError(fluid.field("size") + "[" + std::to_string(d) +
+                       "] = " + format_value(size[d]) + ": must be a whole number of cells");
   c.size = {static_cast<int>(size[0]), static_cast<int>(size[1]), static_cast<int>(size[2])};
   c.relaxation.viscosity = fluid.number(
       "viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
@@ -70,22 +71,26 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   InputReader init = fluid.object("initial");
   InitialField& in = c.initial;
   in.type = init.choice("type", {"rest", "uniform", "shear_wave", "taylor_green"}, "rest");
-  const Range speed{.at_least = -kMaxLatticeSpeed, .at_most = kMaxLatticeSpeed,
+  const Range speed{.at_least = -kMaxLatticeSpeed,
+                    .at_most = kMaxLatticeSpeed,
                     .why = "(Mach limit |u| <= 0.2 c_s)"};
   const auto u = init.numbers("velocity", 3, speed, std::vector<double>{0, 0, 0});
   in.mean_velocity = {u[0], u[1], u[2]};
   const bool wave = in.type == "shear_wave" || in.type == "taylor_green";
   if (wave) {
-    in.amplitude = init.number("amplitude", {.at_least = 0, .at_most = kMaxLatticeSpeed,
-                                             .why = "(Mach limit |u| <= 0.2 c_s)"});
-    in.wavelengths = static_cast<int>(init.integer("wavelengths", {.at_least = 1, .at_most = 1024}, 1));
+    in.amplitude = init.number(
+        "amplitude",
+        {.at_least = 0, .at_most = kMaxLatticeSpeed, .why = "(Mach limit |u| <= 0.2 c_s)"});
+    in.wavelengths =
+        static_cast<int>(init.integer("wavelengths", {.at_least = 1, .at_most = 1024}, 1));
   }
   if (in.type == "shear_wave") {
     in.axis = axis_index(init.choice("axis", {"x", "y", "z"}, "x"));
     in.component = axis_index(init.choice("component", {"x", "y", "z"}, "y"));
     if (in.component == in.axis)
       throw InputError(init.field("component") + " = \"" + kAxisNames[in.component] +
-                       "\": must differ from " + init.field("axis") + " (a shear wave is transverse)");
+                       "\": must differ from " + init.field("axis") +
+                       " (a shear wave is transverse)");
   }
   if (in.type == "taylor_green") {
     const std::string plane = init.choice("plane", {"xy", "yz", "zx"}, "xy");
@@ -93,7 +98,8 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
     in.plane_second = axis_index(plane.substr(1, 1));
   }
   in.noise = init.number("noise", {.at_least = 0, .at_most = kMaxLatticeSpeed}, 0.0);
-  in.seed = static_cast<unsigned>(init.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
+  in.seed =
+      static_cast<unsigned>(init.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
   init.finish();
   fluid.finish();
 
@@ -101,9 +107,10 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   auto check_resolution = [&](int axis) {
     const int n = extent_along(c.size, axis);
     if (n < 4 * in.wavelengths)
-      throw InputError(fluid.field("size") + "[" + std::to_string(axis) + "] = " + std::to_string(n) +
-                       ": must be >= 4 x fluid.initial.wavelengths = " +
-                       std::to_string(4 * in.wavelengths) + " to resolve the initial wave");
+      throw InputError(
+          fluid.field("size") + "[" + std::to_string(axis) + "] = " + std::to_string(n) +
+          ": must be >= 4 x fluid.initial.wavelengths = " + std::to_string(4 * in.wavelengths) +
+          " to resolve the initial wave");
   };
   if (in.type == "shear_wave") check_resolution(in.axis);
   if (in.type == "taylor_green") {
@@ -138,9 +145,10 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const double fmag = std::hypot(c.body_force.x, c.body_force.y, c.body_force.z);
   const double final_mean = mean + fmag * static_cast<double>(c.run.steps);
   if (fmag > 0 && final_mean > kMaxLatticeSpeed)
-    throw InputError("fluid.body_force = [" + format_value(c.body_force.x) + ", " + format_value(c.body_force.y) +
-                     ", " + format_value(c.body_force.z) + "]: accelerates the mean flow to |u| = " +
-                     format_value(final_mean) + " after run.steps = " + std::to_string(c.run.steps) +
+    throw InputError("fluid.body_force = [" + format_value(c.body_force.x) + ", " +
+                     format_value(c.body_force.y) + ", " + format_value(c.body_force.z) +
+                     "]: accelerates the mean flow to |u| = " + format_value(final_mean) +
+                     " after run.steps = " + std::to_string(c.run.steps) +
                      "; must stay <= " + format_value(kMaxLatticeSpeed) +
                      " (Mach limit |u| <= 0.2 c_s; a periodic box has nothing to balance it)");
   // Memory: 19 populations per cell in the chosen precision.
@@ -148,8 +156,9 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
                        (c.precision == Precision::double_precision ? 8.0 : 4.0);
   const double available = physical_memory_bytes();
   if (available > 0 && bytes > 0.8 * available)
-    throw InputError("fluid.size = [" + std::to_string(c.size.nx) + ", " + std::to_string(c.size.ny) +
-                     ", " + std::to_string(c.size.nz) + "]: needs " + format_value(bytes / 1e9) +
+    throw InputError("fluid.size = [" + std::to_string(c.size.nx) + ", " +
+                     std::to_string(c.size.ny) + ", " + std::to_string(c.size.nz) + "]: needs " +
+                     format_value(bytes / 1e9) +
                      " GB for the populations; must fit in 80 % of this machine's " +
                      format_value(available / 1e9) + " GB");
   return c;
@@ -192,7 +201,8 @@ nlohmann::json FluidCase::to_json() const {
 double initial_wave_number(const FluidCase& c) {
   const auto& in = c.initial;
   if (in.type == "shear_wave") return 2 * M_PI * in.wavelengths / extent_along(c.size, in.axis);
-  if (in.type == "taylor_green") return 2 * M_PI * in.wavelengths / extent_along(c.size, in.plane_first);
+  if (in.type == "taylor_green")
+    return 2 * M_PI * in.wavelengths / extent_along(c.size, in.plane_first);
   return 0.0;
 }
 
@@ -201,7 +211,8 @@ double analytic_decay_rate(const FluidCase& c) {
   if (c.initial.type == "shear_wave") return nu * k * k;
   if (c.initial.type == "taylor_green") {
     // both wave numbers of the vortex: nu (k1^2 + k2^2)
-    const double k2 = 2 * M_PI * c.initial.wavelengths / extent_along(c.size, c.initial.plane_second);
+    const double k2 =
+        2 * M_PI * c.initial.wavelengths / extent_along(c.size, c.initial.plane_second);
     return nu * (k * k + k2 * k2);
   }
   return 0.0;
@@ -224,7 +235,8 @@ lattice::Macroscopic initial_state(const FluidCase& c, int x, int y, int z) {
     const double U = in.amplitude, ratio = k1 / k2;
     u[a] += -U * std::cos(k1 * r[a]) * std::sin(k2 * r[b]);
     u[b] += U * ratio * std::sin(k1 * r[a]) * std::cos(k2 * r[b]);
-    const double p = -0.25 * U * U * (std::cos(2 * k1 * r[a]) + ratio * ratio * std::cos(2 * k2 * r[b]));
+    const double p =
+        -0.25 * U * U * (std::cos(2 * k1 * r[a]) + ratio * ratio * std::cos(2 * k2 * r[b]));
     rho = 1.0 + 3.0 * p;
   }
   if (in.noise > 0) {

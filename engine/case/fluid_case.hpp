@@ -25,11 +25,11 @@ struct InitialField {
   std::string type = "rest";  // rest | uniform | shear_wave | taylor_green
   lattice::Vector3 mean_velocity;
   double amplitude = 0.0;
-  int wavelengths = 1;       // whole wavelengths across the box
-  int axis = 0;              // shear wave: direction of the wave vector (0 = x)
-  int component = 1;         // shear wave: velocity component
+  int wavelengths = 1;                    // whole wavelengths across the box
+  int axis = 0;                           // shear wave: direction of the wave vector (0 = x)
+  int component = 1;                      // shear wave: velocity component
   int plane_first = 0, plane_second = 1;  // Taylor-Green plane
-  double noise = 0.0;        // amplitude of uniform random velocity perturbations
+  double noise = 0.0;                     // amplitude of uniform random velocity perturbations
   unsigned seed = 1;
 };
 
@@ -39,7 +39,7 @@ struct RunControl {
   double checkpoint_every_s = 600.0;
   long fields_every = 0;  // steps between field snapshots; 0: final state only
   bool write_fields = false;
-  int threads = 0;        // 0: all available
+  int threads = 0;  // 0: all available
 };
 
 struct FluidCase {

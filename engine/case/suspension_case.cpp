@@ -5,8 +5,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "engine/case/fluid_case.hpp"
 #include "engine/case/case_support.hpp"
+#include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -16,7 +16,6 @@ using input::InputReader;
 using input::Range;
 
 namespace {
-
 
 // Resolution, domain and durations of each fidelity preset. The paper preset
 // is the paper's default case (a = 6 dx, L = 48a, L/W = 2); standard keeps
@@ -44,21 +43,26 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
   const Preset p = preset(c.fidelity);
   c.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
-  c.seed = static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
+  c.seed =
+      static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 
   const bool single = c.scene == "single-sphere";
-  if (!single) c.phi = root.number("phi", {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
+  if (!single)
+    c.phi = root.number("phi",
+                        {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
   c.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
-  c.density_ratio = root.number("density_ratio", {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
+  c.density_ratio = root.number("density_ratio",
+                                {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
   c.du_over_uinf = root.number("du_over_Uinf", {.at_least = 0, .at_most = 0.5}, 0.0);
   c.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
   c.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
   c.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
-  c.lubrication_onset_over_a = root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
-  c.lubrication_saturation_over_a =
-      root.number("lubrication_saturation_over_a", {.above = 0, .below = c.lubrication_onset_over_a,
-                                                    .why = "(below lubrication_onset_over_a)"},
-                  2e-4);
+  c.lubrication_onset_over_a =
+      root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
+  c.lubrication_saturation_over_a = root.number(
+      "lubrication_saturation_over_a",
+      {.above = 0, .below = c.lubrication_onset_over_a, .why = "(below lubrication_onset_over_a)"},
+      2e-4);
   c.length_over_a = root.number("L_over_a", {.at_least = 8, .at_most = 256}, p.length_over_a);
   c.length_over_width = root.number("L_over_W", {.at_least = 0.25, .at_most = 8}, 2.0);
 
@@ -66,13 +70,17 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.radius_cells = num.number("a_over_dx", {.at_least = 3, .at_most = 24}, p.radius_cells);
   const bool has_nu = num.has("viscosity"), has_u = num.has("U_inf");
   if (has_nu && has_u)
-    throw InputError("numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the other through Re_inf)");
+    throw InputError(
+        "numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the "
+        "other through Re_inf)");
   const double a = c.radius_cells;
   if (has_nu) {
-    c.viscosity = num.number("viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
+    c.viscosity = num.number(
+        "viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
     c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
   } else {
-    const Range u_range{.above = 0, .at_most = kMaxSettlingVelocity, .why = "(Mach limit for settling flows)"};
+    const Range u_range{
+        .above = 0, .at_most = kMaxSettlingVelocity, .why = "(Mach limit for settling flows)"};
     c.settling_velocity = num.number("U_inf", u_range, kDefaultSettlingVelocity);
     c.viscosity = c.settling_velocity * 2 * a / c.reynolds_inf;
     // by default stay inside the tested viscosity range: lower U_inf instead
@@ -84,19 +92,23 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
   num.finish();
   if (c.settling_velocity > kMaxSettlingVelocity)
-    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) + " * " + format_value(c.viscosity) +
-                     " / " + format_value(2 * a) + " = " + format_value(c.settling_velocity) + ": must be <= " +
-                     format_value(kMaxSettlingVelocity) + " (Mach limit for settling flows); lower numerics.viscosity");
+    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) +
+                     " * " + format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
+                     format_value(c.settling_velocity) +
+                     ": must be <= " + format_value(kMaxSettlingVelocity) +
+                     " (Mach limit for settling flows); lower numerics.viscosity");
   if (c.viscosity < kSmallestTestedViscosity)
-    c.warnings.push_back("viscosity = " + format_value(c.viscosity) + " is below the smallest tested (" +
+    c.warnings.push_back("viscosity = " + format_value(c.viscosity) +
+                         " is below the smallest tested (" +
                          format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
 
   InputReader pr = root.object("protocol");
   const Range duration{.at_least = 0, .at_most = 1e5};
   c.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
-  c.stage1_max = pr.number("stage1_max", {.at_least = c.stage1_min, .at_most = 1e5,
-                                           .why = "(at least protocol.stage1_min)"},
-                           p.stage1_max);
+  c.stage1_max =
+      pr.number("stage1_max",
+                {.at_least = c.stage1_min, .at_most = 1e5, .why = "(at least protocol.stage1_min)"},
+                p.stage1_max);
   c.stage2_settle = pr.number("stage2_settle", duration, p.stage2_settle);
   c.statistics = pr.number("statistics", {.above = 0, .at_most = 1e5}, p.statistics);
   c.sample_every = pr.number("sample_every", {.above = 0, .at_most = 100}, 0.5);
@@ -107,8 +119,10 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
   pr.finish();
   if (c.statistics < 20 * c.sample_every)
-    throw InputError("protocol.statistics = " + format_value(c.statistics) + ": must be >= 20 x protocol.sample_every = " +
-                     format_value(20 * c.sample_every) + " (10 batch means of at least 2 samples each)");
+    throw InputError(
+        "protocol.statistics = " + format_value(c.statistics) +
+        ": must be >= 20 x protocol.sample_every = " + format_value(20 * c.sample_every) +
+        " (10 batch means of at least 2 samples each)");
   root.finish();
 
   // ---- lattice-unit quantities (SPEC section 2) -----------------------------
@@ -119,14 +133,17 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   // well and event ranges, 2(a + delta) plus a skin, are shorter): that must
   // stay below half the box so that a pair has one periodic image only.
   if (W <= 6 * a)
-    throw InputError("L_over_W = " + format_value(c.length_over_width) + " with L_over_a = " + format_value(c.length_over_a) +
-                     ": makes the box width W = " + std::to_string(W) + " cells; must exceed 6a = " + format_value(6 * a) +
+    throw InputError("L_over_W = " + format_value(c.length_over_width) +
+                     " with L_over_a = " + format_value(c.length_over_a) +
+                     ": makes the box width W = " + std::to_string(W) +
+                     " cells; must exceed 6a = " + format_value(6 * a) +
                      " so that pairs within 3a have a single periodic image");
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
   c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));
   if (c.sphere_count < 1)
-    throw InputError("phi = " + format_value(c.phi) + ": gives N = 0 spheres in this box; raise phi or L_over_a");
+    throw InputError("phi = " + format_value(c.phi) +
+                     ": gives N = 0 spheres in this box; raise phi or L_over_a");
   c.phi_realised = c.sphere_count * sphere_volume / volume;
   if (single) c.phi = c.phi_realised;
 
@@ -138,14 +155,18 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.well_width = c.delta_over_a * a;
   // rho_bar - rho = phi (rho_p - rho); rho_p - rho_bar = (1 - phi)(rho_p - rho)
   c.liquid_body_force = c.phi_realised * (c.density_ratio - 1.0) * c.gravity;
-  c.sphere_net_gravity = (1.0 - c.phi_realised) * (c.density_ratio - 1.0) * sphere_volume * c.gravity;
+  c.sphere_net_gravity =
+      (1.0 - c.phi_realised) * (c.density_ratio - 1.0) * sphere_volume * c.gravity;
 
-  const double bytes = static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
+  const double bytes =
+      static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
   const double available = physical_memory_bytes();
   if (c.scene != "granular" && available > 0 && bytes > 0.8 * available)
-    throw InputError("L_over_a = " + format_value(c.length_over_a) + ", a_over_dx = " + format_value(a) + ": the " +
-                     std::to_string(L) + " x " + std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
-                     format_value(bytes / 1e9) + " GB; must fit in 80 % of this machine's " + format_value(available / 1e9) + " GB");
+    throw InputError("L_over_a = " + format_value(c.length_over_a) +
+                     ", a_over_dx = " + format_value(a) + ": the " + std::to_string(L) + " x " +
+                     std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
+                     format_value(bytes / 1e9) + " GB; must fit in 80 % of this machine's " +
+                     format_value(available / 1e9) + " GB");
   return c;
 }
 
@@ -167,11 +188,16 @@ nlohmann::json SuspensionCase::to_json() const {
   j["L_over_a"] = length_over_a;
   j["L_over_W"] = length_over_width;
   j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
-  j["protocol"] = {{"stage1_min", stage1_min},         {"stage1_max", stage1_max},
-                   {"stage2_settle", stage2_settle},   {"statistics", statistics},
-                   {"sample_every", sample_every},     {"stationarity_window", stationarity_window},
-                   {"snapshot_every", snapshot_every}, {"checkpoint_every_s", checkpoint_every_s},
-                   {"progress_every_s", progress_every_s}, {"threads", threads}};
+  j["protocol"] = {{"stage1_min", stage1_min},
+                   {"stage1_max", stage1_max},
+                   {"stage2_settle", stage2_settle},
+                   {"statistics", statistics},
+                   {"sample_every", sample_every},
+                   {"stationarity_window", stationarity_window},
+                   {"snapshot_every", snapshot_every},
+                   {"checkpoint_every_s", checkpoint_every_s},
+                   {"progress_every_s", progress_every_s},
+                   {"threads", threads}};
   return j;
 }
 

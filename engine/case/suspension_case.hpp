@@ -33,32 +33,32 @@ struct SuspensionCase {
   std::uint64_t seed = 1;
 
   // ---- dimensionless inputs (paper Table 1) --------------------------------
-  double phi = 0.20;              // requested solids fraction
-  double reynolds_inf = 12;       // Re_inf = U_inf 2a / nu
-  double density_ratio = 4.0;     // rho_p / rho
-  double du_over_uinf = 0.0;      // square-well strength
-  double delta_over_a = 0.025;    // square-well width
-  double restitution = 1.0;       // e
-  double friction = 0.0;          // mu_f
-  double lubrication_onset_over_a = 0.2;         // s0 / a
-  double lubrication_saturation_over_a = 2e-4;   // s1 / a
-  double length_over_a = 48;      // L / a
-  double length_over_width = 2;   // L / W
+  double phi = 0.20;                            // requested solids fraction
+  double reynolds_inf = 12;                     // Re_inf = U_inf 2a / nu
+  double density_ratio = 4.0;                   // rho_p / rho
+  double du_over_uinf = 0.0;                    // square-well strength
+  double delta_over_a = 0.025;                  // square-well width
+  double restitution = 1.0;                     // e
+  double friction = 0.0;                        // mu_f
+  double lubrication_onset_over_a = 0.2;        // s0 / a
+  double lubrication_saturation_over_a = 2e-4;  // s1 / a
+  double length_over_a = 48;                    // L / a
+  double length_over_width = 2;                 // L / W
 
   // ---- numerics --------------------------------------------------------------
-  double radius_cells = 6;        // hydrodynamic radius a / dx
-  double viscosity = 0;           // lattice nu (derived when not given)
+  double radius_cells = 6;  // hydrodynamic radius a / dx
+  double viscosity = 0;     // lattice nu (derived when not given)
   double trt_magic = 0.25;
 
   // ---- protocol (durations in a / U_inf) -------------------------------------
-  double stage1_min = 20;         // du = 0 stage: at least this long ...
-  double stage1_max = 100;        // ... until stationary, at most this long
-  double stage2_settle = 50;      // du at target: before statistics start
-  double statistics = 100;        // averaging window
-  double sample_every = 0.5;      // time-series cadence
+  double stage1_min = 20;     // du = 0 stage: at least this long ...
+  double stage1_max = 100;    // ... until stationary, at most this long
+  double stage2_settle = 50;  // du at target: before statistics start
+  double statistics = 100;    // averaging window
+  double sample_every = 0.5;  // time-series cadence
   double stationarity_window = 20;
   double checkpoint_every_s = 600;
-  double snapshot_every = 10;     // sphere snapshots, a / U_inf (0: none)
+  double snapshot_every = 10;  // sphere snapshots, a / U_inf (0: none)
   double progress_every_s = 2;
   int threads = 0;
 
@@ -77,8 +77,8 @@ struct SuspensionCase {
 
   std::vector<std::string> warnings;
 
-  nlohmann::json to_json() const;      // the canonical case, defaults filled in
-  nlohmann::json derived_json() const; // the lattice-unit quantities, for logs and result.json
+  nlohmann::json to_json() const;       // the canonical case, defaults filled in
+  nlohmann::json derived_json() const;  // the lattice-unit quantities, for logs and result.json
 };
 
 // Validates everything before any work starts; throws input::InputError that

@@ -46,7 +46,9 @@ InputReader::InputReader(const nlohmann::json& object, std::string path)
                      ": must be a JSON object");
 }
 
-bool InputReader::has(const std::string& key) const { return object_.contains(key); }
+bool InputReader::has(const std::string& key) const {
+  return object_.contains(key);
+}
 
 const nlohmann::json* InputReader::find(const std::string& key) {
   known_.push_back(key);
@@ -54,7 +56,8 @@ const nlohmann::json* InputReader::find(const std::string& key) {
   return it == object_.end() ? nullptr : &*it;
 }
 
-double InputReader::number(const std::string& key, const Range& range, std::optional<double> fallback) {
+double InputReader::number(const std::string& key, const Range& range,
+                           std::optional<double> fallback) {
   const nlohmann::json* v = find(key);
   if (!v) {
     if (fallback) return *fallback;
@@ -68,7 +71,8 @@ double InputReader::number(const std::string& key, const Range& range, std::opti
   return x;
 }
 
-long InputReader::integer(const std::string& key, const Range& range, std::optional<long> fallback) {
+long InputReader::integer(const std::string& key, const Range& range,
+                          std::optional<long> fallback) {
   const nlohmann::json* v = find(key);
   if (!v) {
     if (fallback) return *fallback;
@@ -91,7 +95,8 @@ bool InputReader::boolean(const std::string& key, std::optional<bool> fallback) 
     if (fallback) return *fallback;
     throw InputError(field(key) + " is missing: true or false is required");
   }
-  if (!v->is_boolean()) throw InputError(field(key) + " = " + v->dump() + ": must be true or false");
+  if (!v->is_boolean())
+    throw InputError(field(key) + " = " + v->dump() + ": must be true or false");
   return v->get<bool>();
 }
 
@@ -108,13 +113,15 @@ std::string InputReader::text(const std::string& key, std::optional<std::string>
 std::string InputReader::choice(const std::string& key, const std::vector<std::string>& allowed,
                                 std::optional<std::string> fallback) {
   std::string list;
-  for (std::size_t i = 0; i < allowed.size(); ++i) list += (i ? ", " : "") + ("\"" + allowed[i] + "\"");
+  for (std::size_t i = 0; i < allowed.size(); ++i)
+    list += (i ? ", " : "") + ("\"" + allowed[i] + "\"");
   const nlohmann::json* v = find(key);
   if (!v) {
     if (fallback) return *fallback;
     throw InputError(field(key) + " is missing: one of " + list + " is required");
   }
-  if (!v->is_string() || std::find(allowed.begin(), allowed.end(), v->get<std::string>()) == allowed.end())
+  if (!v->is_string() ||
+      std::find(allowed.begin(), allowed.end(), v->get<std::string>()) == allowed.end())
     throw InputError(field(key) + " = " + v->dump() + ": must be one of " + list);
   return v->get<std::string>();
 }
@@ -135,9 +142,11 @@ std::vector<double> InputReader::numbers(const std::string& key, std::size_t len
   for (std::size_t i = 0; i < length; ++i) {
     const auto& e = (*v)[i];
     const std::string name = field(key) + "[" + std::to_string(i) + "]";
-    if (!e.is_number()) throw InputError(name + " = " + e.dump() + ": must be a number " + range.describe());
+    if (!e.is_number())
+      throw InputError(name + " = " + e.dump() + ": must be a number " + range.describe());
     const double x = e.get<double>();
-    if (!range.contains(x)) throw InputError(name + " = " + format_number(x) + ": must be " + range.describe());
+    if (!range.contains(x))
+      throw InputError(name + " = " + format_number(x) + ": must be " + range.describe());
     out.push_back(x);
   }
   return out;

@@ -36,7 +36,8 @@ class InputReader {
   // Required when `fallback` is empty.
   double number(const std::string& key, const Range& range,
                 std::optional<double> fallback = std::nullopt);
-  long integer(const std::string& key, const Range& range, std::optional<long> fallback = std::nullopt);
+  long integer(const std::string& key, const Range& range,
+               std::optional<long> fallback = std::nullopt);
   bool boolean(const std::string& key, std::optional<bool> fallback = std::nullopt);
   std::string text(const std::string& key, std::optional<std::string> fallback = std::nullopt);
   std::string choice(const std::string& key, const std::vector<std::string>& allowed,
@@ -52,7 +53,9 @@ class InputReader {
   void finish() const;
 
   const std::string& path() const { return path_; }
-  std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  std::string field(const std::string& key) const {
+    return path_.empty() ? key : path_ + "." + key;
+  }
 
  private:
   const nlohmann::json* find(const std::string& key);

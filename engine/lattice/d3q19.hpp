@@ -10,16 +10,21 @@ namespace flocsim::d3q19 {
 inline constexpr int kQ = 19;
 inline constexpr int kPairs = 9;  // moving directions come in 9 opposite pairs
 
-inline constexpr std::array<int, kQ> cx = {0, 1, -1, 0, 0, 0, 0, 1, -1, 1, -1, 1, -1, 1, -1, 0, 0, 0, 0};
-inline constexpr std::array<int, kQ> cy = {0, 0, 0, 1, -1, 0, 0, 1, -1, -1, 1, 0, 0, 0, 0, 1, -1, 1, -1};
-inline constexpr std::array<int, kQ> cz = {0, 0, 0, 0, 0, 1, -1, 0, 0, 0, 0, 1, -1, -1, 1, 1, -1, -1, 1};
+inline constexpr std::array<int, kQ> cx = {0,  1, -1, 0, 0,  0, 0, 1, -1, 1,
+                                           -1, 1, -1, 1, -1, 0, 0, 0, 0};
+inline constexpr std::array<int, kQ> cy = {0, 0, 0, 1, -1, 0, 0,  1, -1, -1,
+                                           1, 0, 0, 0, 0,  1, -1, 1, -1};
+inline constexpr std::array<int, kQ> cz = {0, 0, 0,  0,  0, 1, -1, 0,  0, 0,
+                                           0, 1, -1, -1, 1, 1, -1, -1, 1};
 
 inline constexpr double kWeightRest = 1.0 / 3.0;
 inline constexpr double kWeightAxis = 1.0 / 18.0;
 inline constexpr double kWeightDiagonal = 1.0 / 36.0;
 inline constexpr double kSoundSpeedSquared = 1.0 / 3.0;
 
-constexpr int opposite(int i) { return i == 0 ? 0 : (i % 2 == 1 ? i + 1 : i - 1); }
+constexpr int opposite(int i) {
+  return i == 0 ? 0 : (i % 2 == 1 ? i + 1 : i - 1);
+}
 
 constexpr double weight(int i) {
   if (i == 0) return kWeightRest;

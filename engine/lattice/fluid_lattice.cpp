@@ -45,7 +45,7 @@ struct CollisionConstants {
 // place. F is the force density acting on the cell.
 template <class Real>
 FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
-                                                   const CollisionConstants<Real>& k) {
+                                   const CollisionConstants<Real>& k) {
   Real drho = 0;
 #pragma GCC unroll 19
   for (int i = 0; i < kQ; ++i) drho += f[i];
@@ -245,7 +245,8 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
     if (even) {
       p[i] = storage(i) + row;
     } else {
-      const long up = static_cast<long>(nx) * (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
+      const long up = static_cast<long>(nx) *
+                      (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
       p[i] = storage(opposite(i)) + up - cx[i];
     }
   }
@@ -427,7 +428,8 @@ void FluidLattice<Real>::step_kernel() {
         const int zs[3] = {z == 0 ? nz - 1 : z - 1, z, z == nz - 1 ? 0 : z + 1};
         for (int dz = 0; dz < 3; ++dz)
           for (int dy = 0; dy < 3; ++dy)
-            neighbour_row[dz][dy] = static_cast<long>(nx) * (ys[dy] + static_cast<long>(ny) * zs[dz]);
+            neighbour_row[dz][dy] =
+                static_cast<long>(nx) * (ys[dy] + static_cast<long>(ny) * zs[dz]);
       }
       // Per direction: where this row's incoming populations are read and its
       // outgoing ones written, as pointers indexed by x.
@@ -450,19 +452,19 @@ void FluidLattice<Real>::step_kernel() {
 
       auto update = [&](int x, const Real* const* ld, Real* const* st, int lx, int sx)
                         FLOCSIM_LAMBDA_ALWAYS_INLINE {
-        Real f[kQ];
+                          Real f[kQ];
 #pragma GCC unroll 19
-        for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
-        Real Fcx = bx, Fcy = by, Fcz = bz;
-        if constexpr (kForceField) {
-          Fcx += Fx[x];
-          Fcy += Fy[x];
-          Fcz += Fz[x];
-        }
-        collide(f, Fcx, Fcy, Fcz, k);
+                          for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
+                          Real Fcx = bx, Fcy = by, Fcz = bz;
+                          if constexpr (kForceField) {
+                            Fcx += Fx[x];
+                            Fcy += Fy[x];
+                            Fcz += Fz[x];
+                          }
+                          collide(f, Fcx, Fcy, Fcz, k);
 #pragma GCC unroll 19
-        for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
-      };
+                          for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
+                        };
 
       // Interior of the row: every shifted pointer stays inside the row, so
       // the loop is a plain unit-stride sweep the compiler vectorises.

@@ -59,7 +59,8 @@ class FluidLattice {
   long time_step() const { return time_step_; }
 
   long cell_index(int x, int y, int z) const {
-    return static_cast<long>(x) + static_cast<long>(extent_.nx) * (y + static_cast<long>(extent_.ny) * z);
+    return static_cast<long>(x) +
+           static_cast<long>(extent_.nx) * (y + static_cast<long>(extent_.ny) * z);
   }
 
   // ---- forcing --------------------------------------------------------------
@@ -157,7 +158,8 @@ void FluidLattice<Real>::initialise_equilibrium(Field&& field) {
         const double usq = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
         for (int i = 0; i < kQ; ++i) {
           const double cu = cx[i] * u[0] + cy[i] * u[1] + cz[i] * u[2];
-          const double feq_dev = w[i] * ((rho - 1.0) + rho * (3.0 * cu + 4.5 * cu * cu - 1.5 * usq));
+          const double feq_dev =
+              w[i] * ((rho - 1.0) + rho * (3.0 * cu + 4.5 * cu * cu - 1.5 * usq));
           // At an even time step population i lives in its own slot at its cell;
           // at an odd one it lives in the opposite slot of the upstream cell.
           if (time_step_ % 2 == 0)

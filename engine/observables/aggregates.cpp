@@ -32,8 +32,8 @@ struct DisjointSets {
 
 }  // namespace
 
-Aggregates find_aggregates(const std::vector<spheres::Vec3>& position, const spheres::PeriodicBox& box,
-                           double bond_distance) {
+Aggregates find_aggregates(const std::vector<spheres::Vec3>& position,
+                           const spheres::PeriodicBox& box, double bond_distance) {
   const int n = static_cast<int>(position.size());
   Aggregates out;
   out.size_distribution.assign(static_cast<std::size_t>(n) + 1, 0.0);

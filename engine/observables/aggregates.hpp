@@ -11,14 +11,14 @@
 namespace flocsim::observables {
 
 struct Aggregates {
-  std::vector<int> aggregate_of;           // per sphere: aggregate id 0..count-1
-  std::vector<int> aggregate_size;         // per aggregate: number of spheres
-  std::vector<double> size_distribution;   // p(n), index n = 0..N (p(0) = 0)
-  double mean_size = 0;                    // <n_a>
-  double contacts_per_sphere = 0;          // C_sph: mean number of other centres within bond distance
+  std::vector<int> aggregate_of;          // per sphere: aggregate id 0..count-1
+  std::vector<int> aggregate_size;        // per aggregate: number of spheres
+  std::vector<double> size_distribution;  // p(n), index n = 0..N (p(0) = 0)
+  double mean_size = 0;                   // <n_a>
+  double contacts_per_sphere = 0;  // C_sph: mean number of other centres within bond distance
 };
 
-Aggregates find_aggregates(const std::vector<spheres::Vec3>& position, const spheres::PeriodicBox& box,
-                           double bond_distance);
+Aggregates find_aggregates(const std::vector<spheres::Vec3>& position,
+                           const spheres::PeriodicBox& box, double bond_distance);
 
 }  // namespace flocsim::observables

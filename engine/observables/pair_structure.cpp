@@ -39,7 +39,8 @@ void PairStructure::add_configuration(const std::vector<spheres::Vec3>& position
 
 void PairStructure::restore(const Accumulated& a) {
   if (a.g_counts.size() != g_counts_.size() || a.h_counts.size() != h_counts_.size())
-    throw std::invalid_argument("PairStructure::restore: bin counts differ from this accumulator's");
+    throw std::invalid_argument(
+        "PairStructure::restore: bin counts differ from this accumulator's");
   g_counts_ = a.g_counts;
   h_counts_ = a.h_counts;
   g_normalisation_ = a.g_normalisation;

@@ -19,10 +19,11 @@ class PairStructure {
   // g(r) on [0, r_max_g) with bin dr; h(theta) with bin dtheta for pairs closer than r_max_h.
   PairStructure(double r_max_g, double dr, double r_max_h, double dtheta);
 
-  void add_configuration(const std::vector<spheres::Vec3>& position, const spheres::PeriodicBox& box);
+  void add_configuration(const std::vector<spheres::Vec3>& position,
+                         const spheres::PeriodicBox& box);
 
-  std::vector<double> radial_distribution() const;    // g per bin
-  std::vector<double> angular_distribution() const;   // h per bin
+  std::vector<double> radial_distribution() const;   // g per bin
+  std::vector<double> angular_distribution() const;  // h per bin
   std::vector<double> radial_bin_centres() const;
   std::vector<double> angular_bin_centres() const;
   long configurations() const { return configurations_; }

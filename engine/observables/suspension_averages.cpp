@@ -5,13 +5,15 @@
 
 namespace flocsim::observables {
 
-double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x, double phi) {
+double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x,
+                                 double phi) {
   return (1.0 - phi) * (liquid_mean_velocity_x - sphere_mean_velocity_x);
 }
 
 double dimensionless_drag(double body_force_density, double radius, double phi, double viscosity,
                           double slip_velocity) {
-  const double hydrodynamic_force = body_force_density * 4.0 / 3.0 * M_PI * radius * radius * radius * (1.0 / phi - 1.0);
+  const double hydrodynamic_force =
+      body_force_density * 4.0 / 3.0 * M_PI * radius * radius * radius * (1.0 / phi - 1.0);
   return hydrodynamic_force / (6.0 * M_PI * radius * viscosity * slip_velocity);
 }
 
@@ -45,7 +47,8 @@ std::vector<double> slab_solids_fraction(const std::vector<spheres::Vec3>& posit
     for (double image : {xc - L, xc, xc + L}) {
       const int first = std::max(0, static_cast<int>(std::floor((image - radius) / width)));
       const int last = std::min(slabs - 1, static_cast<int>(std::floor((image + radius) / width)));
-      for (int s = first; s <= last; ++s) volume[s] += cap(s * width - image, (s + 1) * width - image);
+      for (int s = first; s <= last; ++s)
+        volume[s] += cap(s * width - image, (s + 1) * width - image);
     }
   }
   const double slab_volume = width * box.length.y() * box.length.z();

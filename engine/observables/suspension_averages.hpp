@@ -10,7 +10,8 @@ namespace flocsim::observables {
 
 // U = (1 - phi)(<u> - <u_p>) along x: <u> over the liquid volume, <u_p> over
 // the solid volume.
-double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x, double phi);
+double superficial_slip_velocity(double liquid_mean_velocity_x, double sphere_mean_velocity_x,
+                                 double phi);
 
 // F = F_h / (6 pi a nu rho U) with F_h = f (4/3) pi a^3 (1/phi - 1), f the body
 // force density on the liquid (rho = 1 in lattice units).

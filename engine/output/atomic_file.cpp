@@ -39,7 +39,9 @@ void commit_temporary(const std::filesystem::path& temporary, const std::filesys
   fsync_path(temporary, false);
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
-  if (ec) throw std::runtime_error("cannot rename " + temporary.string() + " to " + path.string() + ": " + ec.message());
+  if (ec)
+    throw std::runtime_error("cannot rename " + temporary.string() + " to " + path.string() + ": " +
+                             ec.message());
   const auto dir = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   fsync_path(dir, true);
 }

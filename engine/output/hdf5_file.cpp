@@ -9,13 +9,21 @@ namespace {
 template <class T>
 hid_t memory_type();
 template <>
-hid_t memory_type<double>() { return H5T_NATIVE_DOUBLE; }
+hid_t memory_type<double>() {
+  return H5T_NATIVE_DOUBLE;
+}
 template <>
-hid_t memory_type<float>() { return H5T_NATIVE_FLOAT; }
+hid_t memory_type<float>() {
+  return H5T_NATIVE_FLOAT;
+}
 template <>
-hid_t memory_type<std::int64_t>() { return H5T_NATIVE_INT64; }
+hid_t memory_type<std::int64_t>() {
+  return H5T_NATIVE_INT64;
+}
 template <>
-hid_t memory_type<std::uint8_t>() { return H5T_NATIVE_UINT8; }
+hid_t memory_type<std::uint8_t>() {
+  return H5T_NATIVE_UINT8;
+}
 
 // Closes an HDF5 handle with the matching function when it leaves scope.
 struct Handle {
@@ -31,9 +39,15 @@ struct Handle {
 Hdf5File::Hdf5File(const std::filesystem::path& path, Mode mode) : path_(path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by exceptions below
   switch (mode) {
-    case Mode::create: file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT); break;
-    case Mode::read: file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT); break;
-    case Mode::append: file_ = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT); break;
+    case Mode::create:
+      file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+      break;
+    case Mode::read:
+      file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+      break;
+    case Mode::append:
+      file_ = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+      break;
   }
   if (file_ < 0) throw std::runtime_error("cannot open HDF5 file " + path.string());
 }
@@ -47,7 +61,8 @@ void Hdf5File::close() {
   const herr_t flushed = H5Fflush(file_, H5F_SCOPE_LOCAL);
   const herr_t closed = H5Fclose(file_);
   file_ = -1;
-  if (flushed < 0 || closed < 0) throw std::runtime_error("cannot complete HDF5 file " + path_.string());
+  if (flushed < 0 || closed < 0)
+    throw std::runtime_error("cannot complete HDF5 file " + path_.string());
 }
 
 void Hdf5File::create_group(const std::string& name) {
@@ -92,14 +107,20 @@ std::vector<T> Hdf5File::read(const std::string& name, std::vector<hsize_t>* sha
   return out;
 }
 
-template void Hdf5File::write<double>(const std::string&, const std::vector<hsize_t>&, const double*);
+template void Hdf5File::write<double>(const std::string&, const std::vector<hsize_t>&,
+                                      const double*);
 template void Hdf5File::write<float>(const std::string&, const std::vector<hsize_t>&, const float*);
-template void Hdf5File::write<std::int64_t>(const std::string&, const std::vector<hsize_t>&, const std::int64_t*);
-template void Hdf5File::write<std::uint8_t>(const std::string&, const std::vector<hsize_t>&, const std::uint8_t*);
-template std::vector<double> Hdf5File::read<double>(const std::string&, std::vector<hsize_t>*) const;
+template void Hdf5File::write<std::int64_t>(const std::string&, const std::vector<hsize_t>&,
+                                            const std::int64_t*);
+template void Hdf5File::write<std::uint8_t>(const std::string&, const std::vector<hsize_t>&,
+                                            const std::uint8_t*);
+template std::vector<double> Hdf5File::read<double>(const std::string&,
+                                                    std::vector<hsize_t>*) const;
 template std::vector<float> Hdf5File::read<float>(const std::string&, std::vector<hsize_t>*) const;
-template std::vector<std::int64_t> Hdf5File::read<std::int64_t>(const std::string&, std::vector<hsize_t>*) const;
-template std::vector<std::uint8_t> Hdf5File::read<std::uint8_t>(const std::string&, std::vector<hsize_t>*) const;
+template std::vector<std::int64_t> Hdf5File::read<std::int64_t>(const std::string&,
+                                                                std::vector<hsize_t>*) const;
+template std::vector<std::uint8_t> Hdf5File::read<std::uint8_t>(const std::string&,
+                                                                std::vector<hsize_t>*) const;
 
 namespace {
 
@@ -136,11 +157,13 @@ void Hdf5File::set_attribute(const std::string& object, const std::string& key, 
   write_attribute(file_, path_, object, key, H5T_NATIVE_DOUBLE, &value);
 }
 
-void Hdf5File::set_attribute(const std::string& object, const std::string& key, std::int64_t value) {
+void Hdf5File::set_attribute(const std::string& object, const std::string& key,
+                             std::int64_t value) {
   write_attribute(file_, path_, object, key, H5T_NATIVE_INT64, &value);
 }
 
-void Hdf5File::set_attribute(const std::string& object, const std::string& key, const std::string& value) {
+void Hdf5File::set_attribute(const std::string& object, const std::string& key,
+                             const std::string& value) {
   Handle type{H5Tcopy(H5T_C_S1), H5Tclose};
   H5Tset_size(type.id, value.size() + 1);
   H5Tset_strpad(type.id, H5T_STR_NULLTERM);
@@ -159,7 +182,8 @@ std::string Hdf5File::attribute_string(const std::string& object, const std::str
   Handle obj{open_object(file_, object), H5Oclose};
   if (obj.id < 0) throw std::runtime_error(path_.string() + ": no object " + object);
   Handle attr{H5Aopen(obj.id, key.c_str(), H5P_DEFAULT), H5Aclose};
-  if (attr.id < 0) throw std::runtime_error(path_.string() + ": no attribute " + object + "@" + key);
+  if (attr.id < 0)
+    throw std::runtime_error(path_.string() + ": no attribute " + object + "@" + key);
   Handle type{H5Aget_type(attr.id), H5Tclose};
   const std::size_t size = H5Tget_size(type.id);
   std::string value(size, '\0');

@@ -19,8 +19,8 @@ std::vector<double> flatten(const std::vector<spheres::Vec3>& v) {
 }
 }  // namespace
 
-void write_sphere_snapshot(const fs::path& directory, long step, double time, const spheres::SphereSet& s,
-                           const std::vector<int>& aggregate_of) {
+void write_sphere_snapshot(const fs::path& directory, long step, double time,
+                           const spheres::SphereSet& s, const std::vector<int>& aggregate_of) {
   fs::create_directories(directory);
   const hsize_t n = s.size();
   {
@@ -49,13 +49,18 @@ void write_sphere_snapshot(const fs::path& directory, long step, double time, co
     x << "<Grid Name=\"step " << st << "\" GridType=\"Uniform\">\n  <Time Value=\"" << t << "\"/>\n"
       << "  <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\"/>\n"
       << "  <Geometry GeometryType=\"XYZ\">\n    <DataItem Dimensions=\"" << n
-      << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/position</DataItem>\n"
+      << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file
+      << ":/position</DataItem>\n"
       << "  </Geometry>\n"
-      << "  <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Node\">\n    <DataItem Dimensions=\"" << n
-      << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/velocity</DataItem>\n"
+      << "  <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Node\">\n    <DataItem "
+         "Dimensions=\""
+      << n << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file
+      << ":/velocity</DataItem>\n"
       << "  </Attribute>\n"
-      << "  <Attribute Name=\"aggregate\" AttributeType=\"Scalar\" Center=\"Node\">\n    <DataItem Dimensions=\"" << n
-      << "\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file << ":/aggregate</DataItem>\n"
+      << "  <Attribute Name=\"aggregate\" AttributeType=\"Scalar\" Center=\"Node\">\n    <DataItem "
+         "Dimensions=\""
+      << n << "\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << file
+      << ":/aggregate</DataItem>\n"
       << "  </Attribute>\n</Grid>\n";
   }
   x << "</Grid>\n</Domain>\n</Xdmf>\n";

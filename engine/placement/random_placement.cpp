@@ -7,14 +7,17 @@
 
 namespace flocsim::placement {
 
-std::vector<spheres::Vec3> place_randomly(const PlacementRequest& r, const spheres::PeriodicBox& box) {
+std::vector<spheres::Vec3> place_randomly(const PlacementRequest& r,
+                                          const spheres::PeriodicBox& box) {
   using spheres::Vec3;
   const double contact = 2.0 * r.radius + r.minimum_gap;
-  if (r.count < 0 || r.radius <= 0) throw std::invalid_argument("place_randomly: count >= 0 and radius > 0 required");
+  if (r.count < 0 || r.radius <= 0)
+    throw std::invalid_argument("place_randomly: count >= 0 and radius > 0 required");
   for (int k = 0; k < 3; ++k)
     if (box.length[k] < 2.0 * contact)
       throw std::invalid_argument("place_randomly: box length " + std::to_string(box.length[k]) +
-                                  " must be at least twice the contact distance " + std::to_string(contact));
+                                  " must be at least twice the contact distance " +
+                                  std::to_string(contact));
   // cell grid: cells at least one contact distance wide, so overlaps are
   // found among the 27 cells around a trial position
   int cells[3];
@@ -35,11 +38,11 @@ std::vector<spheres::Vec3> place_randomly(const PlacementRequest& r, const spher
     for (;;) {
       if (++tries_here > r.max_trials_per_sphere) {
         const double phi = r.count * 4.0 / 3.0 * M_PI * std::pow(r.radius, 3) / box.volume();
-        throw std::runtime_error(
-            "random placement stalled after " + std::to_string(placed.size()) + " of " +
-            std::to_string(r.count) + " spheres (phi = " + std::to_string(phi) + ", " +
-            std::to_string(trials) +
-            " trials): random sequential addition jams near phi = 0.38; lower phi or the minimum gap");
+        throw std::runtime_error("random placement stalled after " + std::to_string(placed.size()) +
+                                 " of " + std::to_string(r.count) + " spheres (phi = " +
+                                 std::to_string(phi) + ", " + std::to_string(trials) +
+                                 " trials): random sequential addition jams near phi = 0.38; lower "
+                                 "phi or the minimum gap");
       }
       ++trials;
       const Vec3 x(u(rng) * box.length.x(), u(rng) * box.length.y(), u(rng) * box.length.z());
@@ -48,7 +51,8 @@ std::vector<spheres::Vec3> place_randomly(const PlacementRequest& r, const spher
       for (int dz = -1; dz <= 1 && free; ++dz)
         for (int dy = -1; dy <= 1 && free; ++dy)
           for (int dx = -1; dx <= 1 && free; ++dx) {
-            const int gx = (c[0] + dx + cells[0]) % cells[0], gy = (c[1] + dy + cells[1]) % cells[1],
+            const int gx = (c[0] + dx + cells[0]) % cells[0],
+                      gy = (c[1] + dy + cells[1]) % cells[1],
                       gz = (c[2] + dz + cells[2]) % cells[2];
             for (int j : grid[gx + cells[0] * (gy + static_cast<std::size_t>(cells[1]) * gz)])
               if (box.minimum_image(placed[j] - x).squaredNorm() < contact2) {

@@ -15,13 +15,14 @@ namespace flocsim::placement {
 struct PlacementRequest {
   int count = 0;
   double radius = 1.0;
-  double minimum_gap = 0.0;       // extra surface-to-surface distance kept free
+  double minimum_gap = 0.0;  // extra surface-to-surface distance kept free
   std::uint64_t seed = 1;
   long max_trials_per_sphere = 100000;
 };
 
 // Throws std::runtime_error naming count, phi and the trials spent when the
 // configuration cannot be completed (too dense for random addition).
-std::vector<spheres::Vec3> place_randomly(const PlacementRequest& request, const spheres::PeriodicBox& box);
+std::vector<spheres::Vec3> place_randomly(const PlacementRequest& request,
+                                          const spheres::PeriodicBox& box);
 
 }  // namespace flocsim::placement

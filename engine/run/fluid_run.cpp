@@ -80,8 +80,8 @@ double wave_amplitude(const FluidLattice<Real>& fluid, const cases::FluidCase& c
 }
 
 template <class Real>
-void write_checkpoint(const fs::path& dir, const FluidLattice<Real>& fluid, const cases::FluidCase& c,
-                      const Baseline& base, double wall_s) {
+void write_checkpoint(const fs::path& dir, const FluidLattice<Real>& fluid,
+                      const cases::FluidCase& c, const Baseline& base, double wall_s) {
   output::TemporaryFile tmp(dir / "checkpoint.h5");
   {
     output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
@@ -108,7 +108,8 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
                      Baseline& base) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
   if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
-    throw input::InputError(file.string() + " belongs to a different case; remove it or use another --out directory");
+    throw input::InputError(
+        file.string() + " belongs to a different case; remove it or use another --out directory");
   for (int i = 0; i < d3q19::kQ; ++i) {
     const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
     if (static_cast<long>(data.size()) != fluid.extent().cells())
@@ -129,21 +130,15 @@ void write_fields(const fs::path& dir, const FluidLattice<Real>& fluid) {
   std::vector<double> rho, ux, uy, uz;
   fluid.macroscopic_fields(rho, ux, uy, uz);
   const auto e = fluid.extent();
-  output::write_field_snapshot(dir / "fields", {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
+  output::write_field_snapshot(dir / "fields",
+                               {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
 }
 
 template <class Real>
 RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   const StartMode start = prepare_output_directory(o.out_dir, o.resume);
   RunLog log(o.out_dir / "run.log", o.quiet);
-  if (start == StartMode::already_completed) {
-    log.info("already completed: " + (o.out_dir / "result.json").string() + " is kept as it is");
-    RunReport r;
-    r.outcome = RunOutcome::completed;
-    std::ifstream in(o.out_dir / "result.json");
-    r.result = nlohmann::json::parse(in);
-    return r;
-  }
+  if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
   for (const auto& w : c.warnings) log.warning(w);
   if (c.run.threads > 0) omp_set_num_threads(c.run.threads);
   const Clock::time_point t_start = Clock::now();
@@ -154,18 +149,22 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   const fs::path checkpoint = o.out_dir / "checkpoint.h5";
   if (start == StartMode::from_checkpoint) {
     read_checkpoint(checkpoint, fluid, c, base);
-    log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(fluid.time_step()));
+    log.info("resumed from " + checkpoint.string() + " at step " +
+             std::to_string(fluid.time_step()));
   } else {
-    fluid.initialise_equilibrium([&](int x, int y, int z) { return cases::initial_state(c, x, y, z); });
+    fluid.initialise_equilibrium(
+        [&](int x, int y, int z) { return cases::initial_state(c, x, y, z); });
     base.mass = fluid.total_mass();
     base.momentum = fluid.total_momentum();
     base.amplitude = wave_amplitude(fluid, c);
   }
-  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " fluid scene: " + std::to_string(c.size.nx) +
-           " x " + std::to_string(c.size.ny) + " x " + std::to_string(c.size.nz) + " cells, nu = " +
-           std::to_string(c.relaxation.viscosity) + " (tau = " + std::to_string(c.relaxation.tau_plus()) +
-           "), " + (sizeof(Real) == 8 ? "double" : "float") + " precision, " +
-           std::to_string(omp_get_max_threads()) + " threads, " + std::to_string(c.run.steps) + " steps");
+  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " fluid scene: " +
+           std::to_string(c.size.nx) + " x " + std::to_string(c.size.ny) + " x " +
+           std::to_string(c.size.nz) + " cells, nu = " + std::to_string(c.relaxation.viscosity) +
+           " (tau = " + std::to_string(c.relaxation.tau_plus()) + "), " +
+           (sizeof(Real) == 8 ? "double" : "float") + " precision, " +
+           std::to_string(omp_get_max_threads()) + " threads, " + std::to_string(c.run.steps) +
+           " steps");
 
   ProgressReporter progress(log, o.out_dir / "progress.json", fluid.time_step(), c.run.steps,
                             c.size.cells(), c.run.progress_every_s);
@@ -188,23 +187,27 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
       if (!std::isfinite(mass)) {
         RunReport r;
         r.outcome = RunOutcome::failed;
-        r.message = "numerical blow-up detected at step " + std::to_string(t) +
-                    ": the liquid mass is no longer finite. " +
-                    (last_good_checkpoint_step >= 0
-                         ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint_step) +
-                               ") is kept in " + checkpoint.string() + ". "
-                         : std::string("No checkpoint had been written yet. ")) +
-                    "Likely causes: velocities beyond the Mach limit or a viscosity too small for the resolution.";
+        r.message =
+            "numerical blow-up detected at step " + std::to_string(t) +
+            ": the liquid mass is no longer finite. " +
+            (last_good_checkpoint_step >= 0
+                 ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint_step) +
+                       ") is kept in " + checkpoint.string() + ". "
+                 : std::string("No checkpoint had been written yet. ")) +
+            "Likely causes: velocities beyond the Mach limit or a viscosity too small for the "
+            "resolution.";
         log.error(r.message);
         return r;
       }
     }
-    if (c.run.write_fields && c.run.fields_every > 0 && t % c.run.fields_every == 0 && t != c.run.steps) {
+    if (c.run.write_fields && c.run.fields_every > 0 && t % c.run.fields_every == 0 &&
+        t != c.run.steps) {
       const Clock::time_point t1 = Clock::now();
       write_fields(o.out_dir, fluid);
       output_s += seconds_since(t1);
     }
-    const bool stop_now = stop_requested() != 0 || (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
+    const bool stop_now =
+        stop_requested() != 0 || (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
     const bool checkpoint_due = seconds_since(last_checkpoint) >= c.run.checkpoint_every_s ||
                                 (o.checkpoint_every_steps > 0 && t % o.checkpoint_every_steps == 0);
     if ((stop_now || checkpoint_due) && t < c.run.steps) {
@@ -217,9 +220,10 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
       last_good_checkpoint_step = t;
       if (stop_now) {
         progress.finish(t);
-        log.info("stopped at step " + std::to_string(t) +
-                 (stop_requested() ? " by signal " + std::to_string(stop_requested()) : std::string()) +
-                 "; checkpoint written, continue with --resume");
+        log.info(
+            "stopped at step " + std::to_string(t) +
+            (stop_requested() ? " by signal " + std::to_string(stop_requested()) : std::string()) +
+            "; checkpoint written, continue with --resume");
         RunReport r;
         r.outcome = RunOutcome::interrupted;
         return r;
@@ -277,25 +281,21 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   result["flocsim_version"] = FLOCSIM_VERSION;
   result["case"] = c.to_json();
   result["observables"] = obs;
-  result["cost"] = {{"wall_s", base.wall_s + wall},
-                    {"wall_s_this_invocation", wall},
-                    {"steps", c.run.steps},
-                    {"steps_this_invocation", steps_here},
-                    {"threads", omp_get_max_threads()},
-                    {"MLUPS", fluid_s > 0 ? steps_here * n / fluid_s / 1e6 : 0.0},
-                    {"modules_s", {{"fluid", fluid_s}, {"output", output_s}, {"checkpoint", checkpoint_s}}}};
-  {
-    const std::time_t now = std::time(nullptr);
-    char buf[64];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    result["completed_at"] = buf;
-  }
+  result["cost"] = {
+      {"wall_s", base.wall_s + wall},
+      {"wall_s_this_invocation", wall},
+      {"steps", c.run.steps},
+      {"steps_this_invocation", steps_here},
+      {"threads", omp_get_max_threads()},
+      {"MLUPS", fluid_s > 0 ? steps_here * n / fluid_s / 1e6 : 0.0},
+      {"modules_s", {{"fluid", fluid_s}, {"output", output_s}, {"checkpoint", checkpoint_s}}}};
+  result["completed_at"] = utc_timestamp();
   output::write_file_atomically(o.out_dir / "result.json", result.dump(2) + "\n");
   // The result is complete on disk; the checkpoint is no longer needed.
   std::error_code ec;
   fs::remove(checkpoint, ec);
-  log.info("completed " + std::to_string(c.run.steps) + " steps in " + format_duration(wall) + " (" +
-           std::to_string(result["cost"]["MLUPS"].get<double>()) + " MLUPS); result in " +
+  log.info("completed " + std::to_string(c.run.steps) + " steps in " + format_duration(wall) +
+           " (" + std::to_string(result["cost"]["MLUPS"].get<double>()) + " MLUPS); result in " +
            (o.out_dir / "result.json").string());
   RunReport r;
   r.outcome = RunOutcome::completed;
@@ -307,7 +307,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
 
 RunReport run_fluid_case(const cases::FluidCase& c, const RunOptions& options) {
   return c.precision == cases::Precision::single_precision ? run_with_precision<float>(c, options)
-                                                            : run_with_precision<double>(c, options);
+                                                           : run_with_precision<double>(c, options);
 }
 
 }  // namespace flocsim::run

@@ -1,5 +1,8 @@
 #include "engine/run/output_directory.hpp"
 
+#include <ctime>
+#include <fstream>
+
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::run {
@@ -12,8 +15,9 @@ StartMode prepare_output_directory(const fs::path& dir, bool resume) {
   const bool checkpoint = fs::exists(dir / "checkpoint.h5");
   if (completed) {
     if (resume) return StartMode::already_completed;
-    throw input::InputError((dir / "result.json").string() +
-                            " exists: the run in this directory has completed; use another --out directory");
+    throw input::InputError(
+        (dir / "result.json").string() +
+        " exists: the run in this directory has completed; use another --out directory");
   }
   if (checkpoint) {
     if (resume) return StartMode::from_checkpoint;
@@ -21,15 +25,33 @@ StartMode prepare_output_directory(const fs::path& dir, bool resume) {
                             " exists: continue it with --resume, or use another --out directory");
   }
   for (const char* stale : {"fields", "spheres"}) fs::remove_all(dir / stale);
-  for (const char* stale : {"fields.xdmf", "spheres.xdmf", "series.h5", "progress.json"}) fs::remove(dir / stale);
+  for (const char* stale : {"fields.xdmf", "spheres.xdmf", "series.h5", "progress.json"})
+    fs::remove(dir / stale);
   return StartMode::fresh;
+}
+
+RunReport completed_run(const fs::path& dir, RunLog& log) {
+  log.info("already completed: " + (dir / "result.json").string() + " is kept as it is");
+  RunReport r;
+  r.outcome = RunOutcome::completed;
+  std::ifstream in(dir / "result.json");
+  r.result = nlohmann::json::parse(in);
+  return r;
+}
+
+std::string utc_timestamp() {
+  const std::time_t now = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return buf;
 }
 
 bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json& current_case) {
   auto physics_only = [](nlohmann::json c) {
     for (const char* group : {"run", "protocol"}) {
       if (!c.contains(group)) continue;
-      for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"}) c[group].erase(key);
+      for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
+        c[group].erase(key);
     }
     if (c.value("scene", "") == "fluid" && c.contains("run")) c["run"].erase("steps");
     return c;

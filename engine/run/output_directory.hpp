@@ -9,12 +9,23 @@
 // Refusals are input errors naming the file and the way out.
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/run/run_log.hpp"
+#include "engine/run/run_types.hpp"
 
 namespace flocsim::run {
 
 enum class StartMode { fresh, from_checkpoint, already_completed };
 
 StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume);
+
+// The report of a run found complete (StartMode::already_completed): its
+// stored result.json, untouched.
+RunReport completed_run(const std::filesystem::path& dir, RunLog& log);
+
+// Now, as result.json's completed_at: ISO 8601 in UTC.
+std::string utc_timestamp();
 
 // A checkpoint may be continued under a case that differs only in run
 // control (threads, progress and checkpoint cadence; for the fluid scene the

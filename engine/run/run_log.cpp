@@ -61,8 +61,8 @@ void RunLog::progress_line(const std::string& line) {
   }
 }
 
-ProgressReporter::ProgressReporter(RunLog& log, std::filesystem::path progress_json, long first_step,
-                                   long steps_total, long cells, double every_s)
+ProgressReporter::ProgressReporter(RunLog& log, std::filesystem::path progress_json,
+                                   long first_step, long steps_total, long cells, double every_s)
     : log_(log),
       progress_json_(std::move(progress_json)),
       first_step_(first_step),
@@ -74,8 +74,10 @@ ProgressReporter::ProgressReporter(RunLog& log, std::filesystem::path progress_j
       last_json_(start_) {}
 
 double ProgressReporter::mlups(long step) const {
-  const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  return sec > 0 ? static_cast<double>(step - first_step_) * static_cast<double>(cells_) / sec / 1e6 : 0.0;
+  const double sec =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  return sec > 0 ? static_cast<double>(step - first_step_) * static_cast<double>(cells_) / sec / 1e6
+                 : 0.0;
 }
 
 void ProgressReporter::update(long step, const std::string& extra) {
@@ -88,9 +90,13 @@ void ProgressReporter::update(long step, const std::string& extra) {
   last_json_ = now;
 }
 
-void ProgressReporter::finish(long step) { report(step, ""); }
+void ProgressReporter::finish(long step) {
+  report(step, "");
+}
 
-void ProgressReporter::set_steps_total(long steps_total) { steps_total_ = steps_total; }
+void ProgressReporter::set_steps_total(long steps_total) {
+  steps_total_ = steps_total;
+}
 
 void ProgressReporter::report(long step, const std::string& extra) {
   const auto now = std::chrono::steady_clock::now();
@@ -100,13 +106,14 @@ void ProgressReporter::report(long step, const std::string& extra) {
   const double eta = rate > 0 ? (steps_total_ - step) / rate : INFINITY;
   const double fraction = steps_total_ > 0 ? static_cast<double>(step) / steps_total_ : 1.0;
   const double m = mlups(step);
-  if (std::chrono::duration<double>(now - last_print_).count() >= every_s_ || step == steps_total_) {
+  if (std::chrono::duration<double>(now - last_print_).count() >= every_s_ ||
+      step == steps_total_) {
     char line[256];
     char rate_text[32] = "";
     if (cells_ > 0) std::snprintf(rate_text, sizeof rate_text, " | %7.1f MLUPS", m);
     std::snprintf(line, sizeof line, "step %ld/%ld (%5.1f%%)%s | ETA %s%s%s", step, steps_total_,
-                  100 * fraction, rate_text, format_duration(eta).c_str(), extra.empty() ? "" : " | ",
-                  extra.c_str());
+                  100 * fraction, rate_text, format_duration(eta).c_str(),
+                  extra.empty() ? "" : " | ", extra.c_str());
     log_.progress_line(line);
   }
   nlohmann::json j = {{"step", step},

@@ -34,12 +34,21 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using spheres::Vec3;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // Columns of the time series, sampled every protocol.sample_every a/U_inf.
-const std::vector<std::string> kColumns = {
-    "step", "time", "stage", "contacts_per_sphere", "mean_aggregate_size", "granular_temperature",
-    "Re_T", "kinetic_energy", "well_energy", "collisions"};
+const std::vector<std::string> kColumns = {"step",
+                                           "time",
+                                           "stage",
+                                           "contacts_per_sphere",
+                                           "mean_aggregate_size",
+                                           "granular_temperature",
+                                           "Re_T",
+                                           "kinetic_energy",
+                                           "well_energy",
+                                           "collisions"};
 
 std::size_t column(const std::string& name) {
   const auto it = std::find(kColumns.begin(), kColumns.end(), name);
@@ -53,7 +62,8 @@ std::size_t column(const std::string& name) {
 observables::PairStructure pair_structure_for(const cases::SuspensionCase& c) {
   const double a = c.radius_cells;
   const double half_box = 0.5 * std::min({c.box.nx, c.box.ny, c.box.nz});
-  return observables::PairStructure(std::min(5.0 * a, half_box - 0.05 * a), 0.05 * a, 3.0 * a, M_PI / 60);
+  return observables::PairStructure(std::min(5.0 * a, half_box - 0.05 * a), 0.05 * a, 3.0 * a,
+                                    M_PI / 60);
 }
 
 // Slabs of phi(x, t): one per sphere radius along x.
@@ -72,8 +82,8 @@ struct RunState {
   std::vector<std::vector<double>> series = std::vector<std::vector<double>>(kColumns.size());
   std::vector<double> size_distribution_sum;  // sum of p(n) over statistics samples
   observables::PairStructure microstructure{1, 1, 1, 1};
-  std::vector<double> phi_x;                  // phi(x, t): one row of slabs per sample
-  double wall_s = 0;                          // before this invocation
+  std::vector<double> phi_x;  // phi(x, t): one row of slabs per sample
+  double wall_s = 0;          // before this invocation
 };
 
 struct Durations {  // protocol in time steps
@@ -82,7 +92,9 @@ struct Durations {  // protocol in time steps
 
 Durations durations(const cases::SuspensionCase& c) {
   const double T = c.convective_time;
-  auto steps = [T](double in_convective_times) { return static_cast<long>(std::llround(in_convective_times * T)); };
+  auto steps = [T](double in_convective_times) {
+    return static_cast<long>(std::llround(in_convective_times * T));
+  };
   Durations d;
   d.sample = std::max(1L, steps(c.sample_every));
   d.stage1_min = steps(c.stage1_min);
@@ -90,7 +102,8 @@ Durations durations(const cases::SuspensionCase& c) {
   d.settle = steps(c.stage2_settle);
   d.statistics = std::max(d.sample, steps(c.statistics));
   d.snapshot = c.snapshot_every > 0 ? std::max(1L, steps(c.snapshot_every)) : 0;
-  d.window_samples = std::max(5L, static_cast<long>(std::llround(c.stationarity_window / c.sample_every)));
+  d.window_samples =
+      std::max(5L, static_cast<long>(std::llround(c.stationarity_window / c.sample_every)));
   return d;
 }
 
@@ -120,22 +133,26 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
     for (const auto& [i, j] : contacts.attached_pairs()) pairs.insert(pairs.end(), {i, j});
     f.write("/spheres/attached_pairs", {pairs.size() / 2, 2}, pairs.data());
     const auto& k = contacts.counters();
-    const std::vector<std::int64_t> counters = {
-        static_cast<std::int64_t>(k.collisions), static_cast<std::int64_t>(k.well_entries),
-        static_cast<std::int64_t>(k.escapes), static_cast<std::int64_t>(k.edge_bounces),
-        static_cast<std::int64_t>(k.neighbour_rebuilds), static_cast<std::int64_t>(k.steps)};
+    const std::vector<std::int64_t> counters = {static_cast<std::int64_t>(k.collisions),
+                                                static_cast<std::int64_t>(k.well_entries),
+                                                static_cast<std::int64_t>(k.escapes),
+                                                static_cast<std::int64_t>(k.edge_bounces),
+                                                static_cast<std::int64_t>(k.neighbour_rebuilds),
+                                                static_cast<std::int64_t>(k.steps)};
     f.write("/event_counters", {counters.size()}, counters.data());
     f.create_group("/series");
     for (std::size_t col = 0; col < kColumns.size(); ++col)
       f.write("/series/" + kColumns[col], {s.series[col].size()}, s.series[col].data());
-    f.write("/size_distribution_sum", {s.size_distribution_sum.size()}, s.size_distribution_sum.data());
+    f.write("/size_distribution_sum", {s.size_distribution_sum.size()},
+            s.size_distribution_sum.data());
     const auto m = s.microstructure.accumulated();
     f.create_group("/microstructure");
     f.write("/microstructure/g_counts", {m.g_counts.size()}, m.g_counts.data());
     f.write("/microstructure/h_counts", {m.h_counts.size()}, m.h_counts.data());
     f.set_attribute("/microstructure", "g_normalisation", m.g_normalisation);
     f.set_attribute("/microstructure", "h_pairs", m.h_pairs);
-    f.set_attribute("/microstructure", "configurations", static_cast<std::int64_t>(m.configurations));
+    f.set_attribute("/microstructure", "configurations",
+                    static_cast<std::int64_t>(m.configurations));
     f.write("/phi_x", {s.phi_x.size()}, s.phi_x.data());
     f.set_attribute("/", "case", c.to_json().dump());
     f.set_attribute("/", "step", static_cast<std::int64_t>(s.step));
@@ -153,7 +170,8 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
                      events::DirectInteractions& contacts) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
   if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
-    throw input::InputError(file.string() + " belongs to a different case; remove it or use another --out directory");
+    throw input::InputError(
+        file.string() + " belongs to a different case; remove it or use another --out directory");
   s.spheres.position = unflatten(f.read<double>("/spheres/position"));
   s.spheres.velocity = unflatten(f.read<double>("/spheres/velocity"));
   s.spheres.angular_velocity = unflatten(f.read<double>("/spheres/angular_velocity"));
@@ -169,7 +187,8 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   counters.edge_bounces = static_cast<std::uint64_t>(k[3]);
   counters.neighbour_rebuilds = static_cast<std::uint64_t>(k[4]);
   counters.steps = static_cast<std::uint64_t>(k[5]);
-  for (std::size_t col = 0; col < kColumns.size(); ++col) s.series[col] = f.read<double>("/series/" + kColumns[col]);
+  for (std::size_t col = 0; col < kColumns.size(); ++col)
+    s.series[col] = f.read<double>("/series/" + kColumns[col]);
   s.size_distribution_sum = f.read<double>("/size_distribution_sum");
   observables::PairStructure::Accumulated m;
   m.g_counts = f.read<double>("/microstructure/g_counts");
@@ -180,8 +199,9 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   s.microstructure.restore(m);
   s.phi_x = f.read<double>("/phi_x");
   if (s.spheres.position.size() != static_cast<std::size_t>(c.sphere_count))
-    throw std::runtime_error(file.string() + ": holds " + std::to_string(s.spheres.position.size()) +
-                             " spheres, the case has " + std::to_string(c.sphere_count));
+    throw std::runtime_error(file.string() + ": holds " +
+                             std::to_string(s.spheres.position.size()) + " spheres, the case has " +
+                             std::to_string(c.sphere_count));
   s.step = f.attribute_int("/", "step");
   s.stage = static_cast<int>(f.attribute_int("/", "stage"));
   s.stage2_start = f.attribute_int("/", "stage2_start");
@@ -213,7 +233,8 @@ std::vector<double> statistics_window(const RunState& s, const std::string& colu
   const std::size_t col = column(column_name);
   std::vector<double> out;
   for (std::size_t k = 0; k < s.series[step_col].size(); ++k)
-    if (s.series[step_col][k] > static_cast<double>(s.statistics_start)) out.push_back(s.series[col][k]);
+    if (s.series[step_col][k] > static_cast<double>(s.statistics_start))
+      out.push_back(s.series[col][k]);
   return out;
 }
 
@@ -239,17 +260,11 @@ const std::vector<std::string>& runnable_sphere_scenes() {
 RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   if (std::find(runnable_sphere_scenes().begin(), runnable_sphere_scenes().end(), c.scene) ==
       runnable_sphere_scenes().end())
-    throw input::InputError("scene = \"" + c.scene + "\": must be one of the scenes this build runs: granular, fluid");
+    throw input::InputError("scene = \"" + c.scene +
+                            "\": must be one of the scenes this build runs: granular, fluid");
   const StartMode start = prepare_output_directory(o.out_dir, o.resume);
   RunLog log(o.out_dir / "run.log", o.quiet);
-  if (start == StartMode::already_completed) {
-    log.info("already completed: " + (o.out_dir / "result.json").string() + " is kept as it is");
-    RunReport r;
-    r.outcome = RunOutcome::completed;
-    std::ifstream in(o.out_dir / "result.json");
-    r.result = nlohmann::json::parse(in);
-    return r;
-  }
+  if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
   for (const auto& w : c.warnings) log.warning(w);
   if (c.threads > 0) omp_set_num_threads(c.threads);
   const Clock::time_point t_start = Clock::now();
@@ -274,7 +289,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(s.step));
   } else {
     s.spheres.resize(static_cast<std::size_t>(c.sphere_count));
-    s.spheres.position = placement::place_randomly({c.sphere_count, c.radius_cells, 0.0, c.seed}, box);
+    s.spheres.position =
+        placement::place_randomly({c.sphere_count, c.radius_cells, 0.0, c.seed}, box);
     // granular gas: Maxwellian velocities with U_inf per component, no net momentum
     std::mt19937_64 rng(c.seed + 1);
     std::normal_distribution<double> maxwell(0.0, c.settling_velocity);
@@ -283,16 +299,18 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     mean /= static_cast<double>(c.sphere_count);
     for (auto& v : s.spheres.velocity) v -= mean;
   }
-  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " " + c.scene + " scene: " + std::to_string(c.sphere_count) +
-           " spheres of radius " + std::to_string(c.radius_cells) + " in " + std::to_string(c.box.nx) + " x " +
-           std::to_string(c.box.ny) + " x " + std::to_string(c.box.nz) + ", phi = " +
-           std::to_string(c.phi_realised) + ", a/U_inf = " + std::to_string(c.convective_time) + " steps");
+  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " " + c.scene + " scene: " +
+           std::to_string(c.sphere_count) + " spheres of radius " + std::to_string(c.radius_cells) +
+           " in " + std::to_string(c.box.nx) + " x " + std::to_string(c.box.ny) + " x " +
+           std::to_string(c.box.nz) + ", phi = " + std::to_string(c.phi_realised) +
+           ", a/U_inf = " + std::to_string(c.convective_time) + " steps");
 
   auto expected_total = [&] {
     if (s.stage == 1) return std::max(s.step, d.stage1_max) + d.settle + d.statistics;
     return s.stage2_start + d.settle + d.statistics;
   };
-  ProgressReporter progress(log, o.out_dir / "progress.json", s.step, expected_total(), 0, c.progress_every_s);
+  ProgressReporter progress(log, o.out_dir / "progress.json", s.step, expected_total(), 0,
+                            c.progress_every_s);
   double events_s = 0, observables_s = 0, output_s = 0, checkpoint_s = 0;
   Clock::time_point last_checkpoint = Clock::now();
   const long first_step = s.step;
@@ -309,7 +327,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
 
     if (s.step % d.sample == 0) {
       t0 = Clock::now();
-      const auto agg = observables::find_aggregates(s.spheres.position, box, 2.0 * (c.radius_cells + c.well_width));
+      const auto agg = observables::find_aggregates(s.spheres.position, box,
+                                                    2.0 * (c.radius_cells + c.well_width));
       const double T = observables::granular_temperature(s.spheres.velocity);
       double kinetic = 0;
       for (const auto& v : s.spheres.velocity) kinetic += 0.5 * mass * v.squaredNorm();
@@ -324,26 +343,30 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                                        contacts.well_energy(s.spheres),
                                        static_cast<double>(contacts.counters().collisions)};
       for (std::size_t col = 0; col < row.size(); ++col) s.series[col].push_back(row[col]);
-      const auto phi = observables::slab_solids_fraction(s.spheres.position, c.radius_cells, box, slabs);
+      const auto phi =
+          observables::slab_solids_fraction(s.spheres.position, c.radius_cells, box, slabs);
       s.phi_x.insert(s.phi_x.end(), phi.begin(), phi.end());
       if (s.statistics_start >= 0) {
-        for (std::size_t n = 0; n < agg.size_distribution.size(); ++n) s.size_distribution_sum[n] += agg.size_distribution[n];
+        for (std::size_t n = 0; n < agg.size_distribution.size(); ++n)
+          s.size_distribution_sum[n] += agg.size_distribution[n];
         s.microstructure.add_configuration(s.spheres.position, box);
       }
       observables_s += seconds_since(t0);
 
       // ---- protocol -----------------------------------------------------------
       if (s.stage == 1 && s.step >= d.stage1_min) {
-        const bool stationary = observables::is_stationary(s.series[signal_column], d.window_samples);
+        const bool stationary =
+            observables::is_stationary(s.series[signal_column], d.window_samples);
         if (stationary || s.step >= d.stage1_max) {
           s.stage = 2;
           s.stage2_start = s.step;
           s.stage1_stationary = stationary;
           contacts.set_escape_velocity(c.escape_velocity);
           if (c.escape_velocity > 0) contacts.attach_pairs_within_well(s.spheres, box);
-          log.info("stage 2 at t U_inf/a = " + std::to_string(s.step / c.convective_time) +
-                   (stationary ? " (stationary)" : " (stage1_max reached before the detector fired)") +
-                   ": du/U_inf = " + std::to_string(c.du_over_uinf));
+          log.info(
+              "stage 2 at t U_inf/a = " + std::to_string(s.step / c.convective_time) +
+              (stationary ? " (stationary)" : " (stage1_max reached before the detector fired)") +
+              ": du/U_inf = " + std::to_string(c.du_over_uinf));
           progress.set_steps_total(expected_total());
         }
       } else if (s.stage == 2 && s.statistics_start < 0 && s.step - s.stage2_start >= d.settle) {
@@ -354,14 +377,17 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     }
     if (d.snapshot > 0 && (s.step % d.snapshot == 0 || done)) {
       t0 = Clock::now();
-      const auto agg = observables::find_aggregates(s.spheres.position, box, 2.0 * (c.radius_cells + c.well_width));
-      output::write_sphere_snapshot(o.out_dir / "spheres", s.step, s.step / c.convective_time, s.spheres,
-                                    agg.aggregate_of);
+      const auto agg = observables::find_aggregates(s.spheres.position, box,
+                                                    2.0 * (c.radius_cells + c.well_width));
+      output::write_sphere_snapshot(o.out_dir / "spheres", s.step, s.step / c.convective_time,
+                                    s.spheres, agg.aggregate_of);
       output_s += seconds_since(t0);
     }
-    const bool stop_now = stop_requested() != 0 || (o.stop_after_steps > 0 && s.step - first_step >= o.stop_after_steps);
-    const bool checkpoint_due = seconds_since(last_checkpoint) >= c.checkpoint_every_s ||
-                                (o.checkpoint_every_steps > 0 && s.step % o.checkpoint_every_steps == 0);
+    const bool stop_now = stop_requested() != 0 ||
+                          (o.stop_after_steps > 0 && s.step - first_step >= o.stop_after_steps);
+    const bool checkpoint_due =
+        seconds_since(last_checkpoint) >= c.checkpoint_every_s ||
+        (o.checkpoint_every_steps > 0 && s.step % o.checkpoint_every_steps == 0);
     if (!done && (stop_now || checkpoint_due)) {
       t0 = Clock::now();
       write_checkpoint(o.out_dir, c, s, contacts, s.wall_s + seconds_since(t_start));
@@ -369,7 +395,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
       last_checkpoint = Clock::now();
       if (stop_now) {
         progress.finish(s.step);
-        log.info("stopped at step " + std::to_string(s.step) + "; checkpoint written, continue with --resume");
+        log.info("stopped at step " + std::to_string(s.step) +
+                 "; checkpoint written, continue with --resume");
         RunReport r;
         r.outcome = RunOutcome::interrupted;
         return r;
@@ -401,18 +428,22 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     obs["energy_relative_change"] = (e1 - e0) / e0;
     const auto times = statistics_window(s, "time");
     const double span = times.back() - times.front();
-    obs["collisions_per_sphere_per_convective_time"] = (collisions.back() - collisions.front()) / c.sphere_count / span;
+    obs["collisions_per_sphere_per_convective_time"] =
+        (collisions.back() - collisions.front()) / c.sphere_count / span;
   }
   std::vector<double> p(s.size_distribution_sum.size());
   const double n_samples = static_cast<double>(statistics_window(s, "step").size());
-  for (std::size_t n = 0; n < p.size(); ++n) p[n] = n_samples > 0 ? s.size_distribution_sum[n] / n_samples : 0.0;
+  for (std::size_t n = 0; n < p.size(); ++n)
+    p[n] = n_samples > 0 ? s.size_distribution_sum[n] / n_samples : 0.0;
   while (p.size() > 2 && p.back() == 0.0) p.pop_back();
   obs["size_distribution"] = p;
   {
-    std::vector<double> r = s.microstructure.radial_bin_centres(), theta = s.microstructure.angular_bin_centres();
+    std::vector<double> r = s.microstructure.radial_bin_centres(),
+                        theta = s.microstructure.angular_bin_centres();
     for (double& x : r) x /= c.radius_cells;
     obs["g_r"] = {{"r_over_a", r}, {"g", s.microstructure.radial_distribution()}};
-    obs["h_theta"] = {{"theta", theta}, {"h", s.microstructure.angular_distribution()},
+    obs["h_theta"] = {{"theta", theta},
+                      {"h", s.microstructure.angular_distribution()},
                       {"pairs_closer_than", "3a"}};
     obs["microstructure_configurations"] = s.microstructure.configurations();
   }
@@ -423,8 +454,11 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   obs["stage2_start"] = s.stage2_start / c.convective_time;
   obs["stage1_stationary"] = s.stage1_stationary;
   const auto& k = contacts.counters();
-  obs["events"] = {{"collisions", k.collisions}, {"well_entries", k.well_entries}, {"escapes", k.escapes},
-                   {"edge_bounces", k.edge_bounces}, {"attached_pairs_final", contacts.attached_count()},
+  obs["events"] = {{"collisions", k.collisions},
+                   {"well_entries", k.well_entries},
+                   {"escapes", k.escapes},
+                   {"edge_bounces", k.edge_bounces},
+                   {"attached_pairs_final", contacts.attached_count()},
                    {"worst_overlap", contacts.worst_overlap()}};
 
   const double wall = seconds_since(t_start);
@@ -440,18 +474,17 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                     {"steps_this_invocation", s.step - first_step},
                     {"threads", omp_get_max_threads()},
                     {"modules_s",
-                     {{"events", events_s}, {"observables", observables_s}, {"output", output_s}, {"checkpoint", checkpoint_s}}}};
-  {
-    const std::time_t now = std::time(nullptr);
-    char buf[64];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    result["completed_at"] = buf;
-  }
+                     {{"events", events_s},
+                      {"observables", observables_s},
+                      {"output", output_s},
+                      {"checkpoint", checkpoint_s}}}};
+  result["completed_at"] = utc_timestamp();
   output::write_file_atomically(o.out_dir / "result.json", result.dump(2) + "\n");
   std::error_code ec;
   fs::remove(checkpoint, ec);
-  log.info("completed " + std::to_string(s.step) + " steps (" + std::to_string(s.step / c.convective_time) +
-           " a/U_inf) in " + format_duration(wall) + "; result in " + (o.out_dir / "result.json").string());
+  log.info("completed " + std::to_string(s.step) + " steps (" +
+           std::to_string(s.step / c.convective_time) + " a/U_inf) in " + format_duration(wall) +
+           "; result in " + (o.out_dir / "result.json").string());
   RunReport r;
   r.outcome = RunOutcome::completed;
   r.result = std::move(result);

@@ -11,7 +11,9 @@ namespace {
 // async-signal-safe and free of data races.
 std::atomic<int> received{0};
 static_assert(std::atomic<int>::is_always_lock_free);
-extern "C" void on_stop_signal(int signal) { received.store(signal, std::memory_order_relaxed); }
+extern "C" void on_stop_signal(int signal) {
+  received.store(signal, std::memory_order_relaxed);
+}
 }  // namespace
 
 void install_stop_handlers() {
@@ -25,8 +27,14 @@ void install_stop_handlers() {
   sigaction(SIGINT, &action, nullptr);
 }
 
-int stop_requested() { return received.load(std::memory_order_relaxed); }
-void request_stop(int signal) { received.store(signal, std::memory_order_relaxed); }
-void clear_stop_request() { received.store(0, std::memory_order_relaxed); }
+int stop_requested() {
+  return received.load(std::memory_order_relaxed);
+}
+void request_stop(int signal) {
+  received.store(signal, std::memory_order_relaxed);
+}
+void clear_stop_request() {
+  received.store(0, std::memory_order_relaxed);
+}
 
 }  // namespace flocsim::run

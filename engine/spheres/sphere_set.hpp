@@ -34,10 +34,10 @@ struct PeriodicBox {
 };
 
 struct SphereSet {
-  double radius = 6.0;          // hydrodynamic radius a: all physics uses this one
-  double density_ratio = 4.0;   // rho_p / rho
-  std::vector<Vec3> position;   // centres, kept inside the box
-  std::vector<Vec3> velocity;   // u_p
+  double radius = 6.0;                 // hydrodynamic radius a: all physics uses this one
+  double density_ratio = 4.0;          // rho_p / rho
+  std::vector<Vec3> position;          // centres, kept inside the box
+  std::vector<Vec3> velocity;          // u_p
   std::vector<Vec3> angular_velocity;  // omega_p
 
   std::size_t size() const { return position.size(); }

@@ -1,9 +1,10 @@
 // Bad input is refused before any work starts with a message that names the
 // field, the value and what is allowed; good input is read with its defaults.
+#include "engine/case/fluid_case.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -51,7 +52,8 @@ TEST(FluidCase, ViscosityAtOrBelowZeroIsRefusedWithTheTauLimit) {
   for (double nu : {0.0, -0.01}) {
     json d = valid_case();
     d["fluid"]["viscosity"] = nu;
-    EXPECT_THAT(refusal(d), AllOf(HasSubstr("fluid.viscosity"), HasSubstr("> 0"), HasSubstr("tau")));
+    EXPECT_THAT(refusal(d),
+                AllOf(HasSubstr("fluid.viscosity"), HasSubstr("> 0"), HasSubstr("tau")));
   }
 }
 
@@ -83,8 +85,8 @@ TEST(FluidCase, VelocitiesBeyondTheMachLimitAreRefused) {
   d = valid_case();
   d["fluid"]["initial"]["velocity"] = {0.08, 0, 0};
   d["fluid"]["initial"]["amplitude"] = 0.05;  // each allowed, their sum is not
-  EXPECT_THAT(refusal(d), AllOf(HasSubstr("peak initial speed"), HasSubstr("0.13"),
-                                HasSubstr("Mach limit")));
+  EXPECT_THAT(refusal(d),
+              AllOf(HasSubstr("peak initial speed"), HasSubstr("0.13"), HasSubstr("Mach limit")));
 }
 
 TEST(FluidCase, BodyForceThatWouldAccelerateBeyondTheMachLimitIsRefused) {
@@ -92,7 +94,8 @@ TEST(FluidCase, BodyForceThatWouldAccelerateBeyondTheMachLimitIsRefused) {
   json d = valid_case();
   d["fluid"]["body_force"] = {1e-4, 0, 0};
   d["run"]["steps"] = 2000;
-  EXPECT_THAT(refusal(d), AllOf(HasSubstr("fluid.body_force"), HasSubstr("0.2"), HasSubstr("Mach")));
+  EXPECT_THAT(refusal(d),
+              AllOf(HasSubstr("fluid.body_force"), HasSubstr("0.2"), HasSubstr("Mach")));
   d["run"]["steps"] = 500;  // u = 0.05: fine
   EXPECT_NO_THROW(parse_fluid_case(d));
 }
@@ -110,7 +113,8 @@ TEST(FluidCase, UnknownKeysAreRefusedWithTheKnownOnes) {
 TEST(FluidCase, WrongTypesAreRefused) {
   json d = valid_case();
   d["fluid"]["viscosity"] = "0.01";
-  EXPECT_THAT(refusal(d), AllOf(HasSubstr("fluid.viscosity"), HasSubstr("\"0.01\""), HasSubstr("number")));
+  EXPECT_THAT(refusal(d),
+              AllOf(HasSubstr("fluid.viscosity"), HasSubstr("\"0.01\""), HasSubstr("number")));
   d = valid_case();
   d["run"]["steps"] = 10.5;
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("run.steps"), HasSubstr("integer")));

@@ -2,10 +2,11 @@
 // the paper's sphere counts; the body force on the liquid balances the net
 // gravity on the spheres (SPEC section 1); bad input refused with field,
 // value and allowed range.
+#include "engine/case/suspension_case.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -34,7 +35,8 @@ TEST(SuspensionCase, PaperDomainGivesThePapersSphereCounts) {
   const int rounded_n[] = {792, 1320, 1650, 2112};  // round(phi * 6600.5), by hand
   const double phis[] = {0.12, 0.20, 0.25, 0.32};
   for (int k = 0; k < 4; ++k) {
-    const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", phis[k]}});
+    const SuspensionCase c =
+        parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", phis[k]}});
     EXPECT_EQ(c.box.nx, 288);
     EXPECT_EQ(c.box.ny, 144);
     EXPECT_EQ(c.box.nz, 144);
@@ -48,7 +50,8 @@ TEST(SuspensionCase, LatticeUnitsByHand) {
   // Re_inf = 12, a = 6, default U_inf = 0.02 -> nu = U 2a / Re = 0.02.
   // C_D = 24/12 (1 + 0.15 * 12^0.687), 12^0.687 = 5.513121 -> C_D = 3.653936.
   // g = (3/8) C_D U^2 / ((rho_p/rho - 1) a) = 0.375 * 3.653936 * 4e-4 / 18.
-  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 12}});
+  const SuspensionCase c =
+      parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 12}});
   EXPECT_DOUBLE_EQ(c.settling_velocity, 0.02);
   EXPECT_NEAR(c.viscosity, 0.02, 1e-15);
   EXPECT_NEAR(c.drag_coefficient, 3.653936, 2e-6);
@@ -61,27 +64,32 @@ TEST(SuspensionCase, LatticeUnitsByHand) {
 TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
   // Hand-worked for the paper box at phi = 0.20 (N = 1320, phi_realised =
   // 1320 / 6600.5), Re_inf = 12, U = 0.02: f = phi (rho_p - rho) g.
-  const SuspensionCase p = parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
+  const SuspensionCase p =
+      parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
   EXPECT_NEAR(p.liquid_body_force, (1320 / (27648 / (4 * M_PI / 3))) * 3 * p.gravity, 1e-18);
   // SPEC section 1: f V (1 - phi) = N (rho_p - rho_bar) (4/3) pi a^3 g.
-  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.25}, {"Re_inf", 24}});
+  const SuspensionCase c =
+      parse_suspension_case({{"scene", "suspension"}, {"phi", 0.25}, {"Re_inf", 24}});
   const double volume = static_cast<double>(c.box.cells());
-  EXPECT_NEAR(c.liquid_body_force * volume * (1 - c.phi_realised), c.sphere_count * c.sphere_net_gravity,
-              1e-12 * c.sphere_count * c.sphere_net_gravity);
+  EXPECT_NEAR(c.liquid_body_force * volume * (1 - c.phi_realised),
+              c.sphere_count * c.sphere_net_gravity, 1e-12 * c.sphere_count * c.sphere_net_gravity);
 }
 
 TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
   // Re_inf = 72 at U_inf = 0.02 would need nu = 0.0033 < 0.005: the default
   // keeps nu = 0.005 and raises U_inf to 72 * 0.005 / 12 = 0.03.
-  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}});
+  const SuspensionCase c =
+      parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}});
   EXPECT_DOUBLE_EQ(c.viscosity, 0.005);
   EXPECT_NEAR(c.settling_velocity, 0.03, 1e-15);
   EXPECT_TRUE(c.warnings.empty());
 }
 
 TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
-  const SuspensionCase c = parse_suspension_case(
-      {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}});
+  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"},
+                                                  {"fidelity", "draft"},
+                                                  {"phi", 0.2},
+                                                  {"numerics", {{"a_over_dx", 8}}}});
   EXPECT_EQ(c.radius_cells, 8);
   EXPECT_EQ(c.box.nx, 16 * 8);  // draft domain L = 16a with the explicit a
   // and the canonical form reads back to the same case
@@ -90,9 +98,10 @@ TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
 
 TEST(SuspensionCase, MachLimitIsStatedWhenBroken) {
   // nu = 0.02 at Re_inf = 72, a = 6: U_inf = 72 * 0.02 / 12 = 0.12 > 0.05
-  const std::string m = refusal({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72},
-                                 {"numerics", {{"viscosity", 0.02}}}});
-  EXPECT_THAT(m, AllOf(HasSubstr("U_inf"), HasSubstr("0.12"), HasSubstr("0.05"), HasSubstr("Mach")));
+  const std::string m = refusal(
+      {{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}, {"numerics", {{"viscosity", 0.02}}}});
+  EXPECT_THAT(m,
+              AllOf(HasSubstr("U_inf"), HasSubstr("0.12"), HasSubstr("0.05"), HasSubstr("Mach")));
 }
 
 TEST(SuspensionCase, BadInputsAreNamed) {

@@ -86,7 +86,8 @@ TEST_F(DbTest, CreatesTheFolderOfANewDatabase) {
   const std::string nested = (dir_ / "runs" / "deeper" / "demo.sqlite").string();
   { ResultsDb db(nested, ResultsDb::Mode::kCreate); }
   EXPECT_TRUE(fs::exists(nested));
-  EXPECT_THROW(ResultsDb((dir_ / "absent" / "x.sqlite").string(), ResultsDb::Mode::kExisting), DbError);
+  EXPECT_THROW(ResultsDb((dir_ / "absent" / "x.sqlite").string(), ResultsDb::Mode::kExisting),
+               DbError);
   EXPECT_FALSE(fs::exists(dir_ / "absent"));
 }
 

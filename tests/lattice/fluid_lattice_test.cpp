@@ -2,6 +2,8 @@
 // analytic decay of shear waves and Taylor-Green vortices, exact momentum
 // growth under a body force, mass conservation, Galilean invariance, stability
 // at the smallest viscosity the model is used at, and float against double.
+#include "engine/lattice/fluid_lattice.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <random>
 
 #include "engine/lattice/d3q19.hpp"
-#include "engine/lattice/fluid_lattice.hpp"
 
 namespace flocsim::lattice {
 namespace {
@@ -129,15 +130,14 @@ TEST_P(ShearWaveViscosity, WithinOnePercentOfInput) {
       << "nu = " << p.nu << ", wave along axis " << p.axis << ", velocity component " << p.comp;
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    VALIDATION, ShearWaveViscosity,
-    ::testing::Values(ShearWaveCase{0.005, 0, 1}, ShearWaveCase{0.01, 0, 1},
-                      ShearWaveCase{0.02, 0, 1}, ShearWaveCase{0.1, 0, 1},
-                      // the other axes and components exercise streaming across
-                      // every periodic face of the box
-                      ShearWaveCase{0.01, 1, 2}, ShearWaveCase{0.01, 2, 0},
-                      ShearWaveCase{0.01, 0, 2}, ShearWaveCase{0.01, 1, 0},
-                      ShearWaveCase{0.01, 2, 1}));
+INSTANTIATE_TEST_SUITE_P(VALIDATION, ShearWaveViscosity,
+                         ::testing::Values(ShearWaveCase{0.005, 0, 1}, ShearWaveCase{0.01, 0, 1},
+                                           ShearWaveCase{0.02, 0, 1}, ShearWaveCase{0.1, 0, 1},
+                                           // the other axes and components exercise streaming
+                                           // across every periodic face of the box
+                                           ShearWaveCase{0.01, 1, 2}, ShearWaveCase{0.01, 2, 0},
+                                           ShearWaveCase{0.01, 0, 2}, ShearWaveCase{0.01, 1, 0},
+                                           ShearWaveCase{0.01, 2, 1}));
 
 TEST(Convergence, ShearWaveViscosityErrorIsSecondOrderInResolution) {
   // The lattice-Boltzmann scheme is second-order accurate in space: the
@@ -171,11 +171,12 @@ TEST(GalileanInvariance, ShearWaveOnUniformFlowDecaysAtTheSameRate) {
   const int steps = static_cast<int>(std::ceil(0.4 / (nu * k * k)));
   const double at_rest = shear_wave<double>(nu, 0, 1, length, steps).measured_viscosity;
   const double along = shear_wave<double>(nu, 0, 1, length, steps, {0.05, 0, 0}).measured_viscosity;
-  const double across = shear_wave<double>(nu, 0, 1, length, steps, {0, 0, 0.05}).measured_viscosity;
+  const double across =
+      shear_wave<double>(nu, 0, 1, length, steps, {0, 0, 0.05}).measured_viscosity;
   const double diagonal =
       shear_wave<double>(nu, 0, 1, length, steps, {0.03, 0.02, 0.03}).measured_viscosity;
-  std::printf("decay rate ratio to rest: along %.5f, across %.5f, diagonal %.5f\n",
-              along / at_rest, across / at_rest, diagonal / at_rest);
+  std::printf("decay rate ratio to rest: along %.5f, across %.5f, diagonal %.5f\n", along / at_rest,
+              across / at_rest, diagonal / at_rest);
   EXPECT_NEAR(along / at_rest, 1.0, 3 * 0.05 * 0.05 + 0.0025);
   EXPECT_NEAR(across / at_rest, 1.0, 0.0025);
   EXPECT_NEAR(diagonal / at_rest, 1.0, 3 * 0.03 * 0.03 + 0.0025);
@@ -191,13 +192,15 @@ TEST(TaylorGreen, VelocityDecaysAtTwiceNuKSquared) {
   FluidLattice<double> fluid({n, n, 2}, {nu, 0.25});
   fluid.initialise_equilibrium([&](int x, int y, int) {
     const double p = -0.25 * U0 * U0 * (std::cos(2 * k * x) + std::cos(2 * k * y));
-    return Macroscopic{1.0 + 3.0 * p,
-                       {-U0 * std::cos(k * x) * std::sin(k * y), U0 * std::sin(k * x) * std::cos(k * y), 0}};
+    return Macroscopic{
+        1.0 + 3.0 * p,
+        {-U0 * std::cos(k * x) * std::sin(k * y), U0 * std::sin(k * x) * std::cos(k * y), 0}};
   });
   auto amplitude = [&] {
     double s = 0;
     for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) s += fluid.macroscopic(x, y, 0).velocity.y * std::sin(k * x) * std::cos(k * y);
+      for (int x = 0; x < n; ++x)
+        s += fluid.macroscopic(x, y, 0).velocity.y * std::sin(k * x) * std::cos(k * y);
     return 4.0 * s / (n * n);
   };
   for (int s = 0; s < 50; ++s) fluid.step();

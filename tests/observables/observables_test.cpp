@@ -23,10 +23,10 @@ TEST(Aggregates, HandBuiltClustersAcrossPeriodicBoundaries) {
   // a pair across the z face, a triangle (3 bonds) and 2 singles: N = 10.
   const PeriodicBox box{Vec3(20, 20, 20)};
   const std::vector<Vec3> x = {
-      {19.0, 5, 5}, {0.9, 5, 5}, {2.8, 5, 5},          // chain (ids 0-2)
-      {10, 10, 19.5}, {10, 10, 1.0},                   // pair across z (3-4)
-      {10, 3, 10}, {12, 3, 10}, {11, 3 + std::sqrt(3.0), 10},  // triangle, sides 2 (5-7)
-      {5, 15, 15}, {15, 15, 5}};                       // singles (8-9)
+      {19.0, 5, 5},   {0.9, 5, 5},   {2.8, 5, 5},                   // chain (ids 0-2)
+      {10, 10, 19.5}, {10, 10, 1.0},                                // pair across z (3-4)
+      {10, 3, 10},    {12, 3, 10},   {11, 3 + std::sqrt(3.0), 10},  // triangle, sides 2 (5-7)
+      {5, 15, 15},    {15, 15, 5}};                                 // singles (8-9)
   const Aggregates a = find_aggregates(x, box, 2.1);
   ASSERT_EQ(a.aggregate_size.size(), 5u);
   EXPECT_EQ(a.aggregate_of[0], a.aggregate_of[2]);
@@ -54,7 +54,8 @@ TEST(Aggregates, AllSinglesGiveMeanSizeOne) {
 std::vector<Vec3> ideal_gas(int n, const PeriodicBox& box, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Vec3> x(static_cast<std::size_t>(n));
-  for (auto& p : x) p = Vec3(u(rng) * box.length.x(), u(rng) * box.length.y(), u(rng) * box.length.z());
+  for (auto& p : x)
+    p = Vec3(u(rng) * box.length.x(), u(rng) * box.length.y(), u(rng) * box.length.z());
   return x;
 }
 
@@ -72,7 +73,8 @@ TEST(PairStructure, IdealGasHasFlatRadialAndAngularDistributions) {
   const double density = (n - 1) / box.volume();
   for (std::size_t b = 1; b < g.size(); ++b) {  // first bin holds too few pairs to test
     const double r0 = b * dr, r1 = r0 + dr;
-    const double expected = configurations * n * density * 4.0 / 3.0 * M_PI * (r1 * r1 * r1 - r0 * r0 * r0);
+    const double expected =
+        configurations * n * density * 4.0 / 3.0 * M_PI * (r1 * r1 * r1 - r0 * r0 * r0);
     // each pair enters twice: relative error 1/sqrt(expected / 2)
     EXPECT_NEAR(g[b], 1.0, 4.0 / std::sqrt(expected / 2)) << "r = " << r[b];
   }
@@ -152,7 +154,8 @@ TEST(BatchMeans, ErrorMatchesAnalyticStandardErrorOfCorrelatedSeries) {
     const long n = 200000;
     const double analytic = std::sqrt((1 + rho) / (1 - rho) / n);
     double ratio = 0;
-    for (unsigned seed = 1; seed <= 10; ++seed) ratio += batch_means(ar1(n, rho, seed), 20).error / analytic / 10;
+    for (unsigned seed = 1; seed <= 10; ++seed)
+      ratio += batch_means(ar1(n, rho, seed), 20).error / analytic / 10;
     EXPECT_NEAR(ratio, 1.0, 0.15) << "rho = " << rho;
   }
 }

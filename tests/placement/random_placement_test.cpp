@@ -3,9 +3,9 @@
 // against all pairs, periodic images included), reproducibly per seed; an
 // impossible request fails with a message instead of hanging. (Its cost, about
 // 0.2 s for the densest case, is reported in the run log, not asserted here.)
-#include <gtest/gtest.h>
-
 #include "engine/placement/random_placement.hpp"
+
+#include <gtest/gtest.h>
 
 namespace flocsim::placement {
 namespace {
@@ -24,7 +24,8 @@ TEST(RandomPlacement, PaperDensestCaseHasNoOverlap) {
       EXPECT_GE(x[i][k], 0.0);
       EXPECT_LT(x[i][k], box.length[k]);
     }
-    for (std::size_t j = i + 1; j < x.size(); ++j) closest = std::min(closest, box.minimum_image(x[j] - x[i]).norm());
+    for (std::size_t j = i + 1; j < x.size(); ++j)
+      closest = std::min(closest, box.minimum_image(x[j] - x[i]).norm());
   }
   EXPECT_GE(closest, 2 * a);
 }
@@ -37,7 +38,8 @@ TEST(RandomPlacement, MinimumGapIsKeptAndSeedsReproduce) {
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
   for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = i + 1; j < a.size(); ++j) EXPECT_GE(box.minimum_image(a[j] - a[i]).norm(), 6.5);
+    for (std::size_t j = i + 1; j < a.size(); ++j)
+      EXPECT_GE(box.minimum_image(a[j] - a[i]).norm(), 6.5);
 }
 
 TEST(RandomPlacement, TooDenseRequestFailsWithAMessage) {

@@ -2,6 +2,8 @@
 // to one that never stopped; a blow-up stops the run with a diagnosis and the
 // last good checkpoint kept; result.json holds the exact body-force momentum
 // and the analytic decay of the initial wave.
+#include "engine/run/fluid_run.hpp"
+
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -12,7 +14,6 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
-#include "engine/run/fluid_run.hpp"
 #include "engine/run/stop_signal.hpp"
 
 namespace flocsim::run {
@@ -22,14 +23,16 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("flocsim_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path p =
+      fs::temp_directory_path() / ("flocsim_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(p);
   return p;
 }
 
 cases::FluidCase shear_wave_case(const std::string& precision) {
   return cases::parse_fluid_case(json::parse(R"({
-    "scene": "fluid", "precision": ")" + precision + R"(",
+    "scene": "fluid", "precision": ")" + precision +
+                                             R"(",
     "fluid": {"size": [24, 6, 5], "viscosity": 0.02, "body_force": [1e-6, 0, -2e-6],
               "initial": {"type": "shear_wave", "amplitude": 0.02, "velocity": [0.01, 0, 0],
                           "noise": 0.001}},
@@ -50,7 +53,8 @@ TEST_P(RestartIdentity, StopAndResumeGivesBitIdenticalFields) {
   // 301 steps and a stop after 151 put the checkpoint in the odd (shifted)
   // layout of the AA pattern, the harder case.
   const cases::FluidCase c = shear_wave_case(GetParam());
-  const fs::path straight = fresh_dir("straight_" + GetParam()), split = fresh_dir("split_" + GetParam());
+  const fs::path straight = fresh_dir("straight_" + GetParam()),
+                 split = fresh_dir("split_" + GetParam());
   RunReport a = run_fluid_case(c, {straight, false, true, 0});
   ASSERT_EQ(a.outcome, RunOutcome::completed);
 
@@ -63,7 +67,8 @@ TEST_P(RestartIdentity, StopAndResumeGivesBitIdenticalFields) {
   EXPECT_FALSE(fs::exists(split / "checkpoint.h5"));  // removed once the result is on disk
 
   for (const char* name : {"density", "velocity_x", "velocity_y", "velocity_z"}) {
-    const auto u = final_field<double>(straight, name, 301), v = final_field<double>(split, name, 301);
+    const auto u = final_field<double>(straight, name, 301),
+               v = final_field<double>(split, name, 301);
     ASSERT_EQ(u.size(), v.size());
     for (std::size_t i = 0; i < u.size(); ++i) ASSERT_EQ(u[i], v[i]) << name << " cell " << i;
   }
@@ -85,7 +90,8 @@ TEST(FluidRun, ResultHoldsExactMomentumAndAnalyticDecay) {
   const auto& obs = on_disk["observables"];
   // momentum grows by exactly f per cell per step (VALIDATION.md)
   for (int d = 0; d < 3; ++d)
-    EXPECT_NEAR(obs["momentum_final"][d].get<double>(), obs["momentum_expected"][d].get<double>(), 1e-11);
+    EXPECT_NEAR(obs["momentum_final"][d].get<double>(), obs["momentum_expected"][d].get<double>(),
+                1e-11);
   EXPECT_NEAR(obs["mass_relative_change"].get<double>(), 0.0, 1e-14);
   // shear wave decay nu k^2 over the whole run, including the start-up
   // transient of an equilibrium initial state: within 2 %
@@ -151,7 +157,8 @@ TEST(FluidRun, ResumeAcceptsOtherRunControlAndExtendsARun) {
   ASSERT_EQ(run_fluid_case(shorter, {split, false, true, 100}).outcome, RunOutcome::interrupted);
   const RunReport b = run_fluid_case(c, {split, true, true, 0});
   ASSERT_EQ(b.outcome, RunOutcome::completed);
-  const auto u = final_field<double>(straight, "velocity_y", 301), v = final_field<double>(split, "velocity_y", 301);
+  const auto u = final_field<double>(straight, "velocity_y", 301),
+             v = final_field<double>(split, "velocity_y", 301);
   EXPECT_EQ(u, v);
   fs::remove_all(straight);
   fs::remove_all(split);

@@ -47,7 +47,8 @@ TEST(FieldSnapshots, OneCompleteFilePerSnapshotWithXdmfIndex) {
   std::ofstream(dir / "fields" / ".step_0000000030.h5.tmp.1") << "partial";
   EXPECT_EQ(snapshot_steps(dir / "fields"), (std::vector<long>{10, 20}));
   std::vector<hsize_t> shape;
-  const auto back = Hdf5File(snapshot_file(dir / "fields", 20), Hdf5File::Mode::read).read<double>("/velocity_z", &shape);
+  const auto back = Hdf5File(snapshot_file(dir / "fields", 20), Hdf5File::Mode::read)
+                        .read<double>("/velocity_z", &shape);
   EXPECT_EQ(shape, (std::vector<hsize_t>{2, 3, 5}));  // [nz][ny][nx]
   EXPECT_EQ(back, uz);
   std::stringstream x;
@@ -59,7 +60,8 @@ TEST(FieldSnapshots, OneCompleteFilePerSnapshotWithXdmfIndex) {
 }
 
 TEST(TemporaryFile, AnAbandonedWriteLeavesThePreviousFileAndNoDebris) {
-  const fs::path dir = fs::temp_directory_path() / ("flocsim_tmpfile_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("flocsim_tmpfile_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   write_file_atomically(dir / "checkpoint.h5", "good");

@@ -3,6 +3,8 @@
 // results; elastic hard spheres with square wells conserve kinetic energy
 // minus the well depth of attached pairs; the protocol's stages and windows
 // are reported; scenes this build cannot run are refused as input errors.
+#include "engine/run/sphere_run.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,7 +14,6 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
-#include "engine/run/sphere_run.hpp"
 
 namespace flocsim::run {
 namespace {
@@ -21,7 +22,8 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("flocsim_sphere_" + name + "_" + std::to_string(::getpid()));
+  const fs::path p =
+      fs::temp_directory_path() / ("flocsim_sphere_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(p);
   return p;
 }
@@ -29,7 +31,8 @@ fs::path fresh_dir(const std::string& name) {
 cases::SuspensionCase granular(double du_over_uinf) {
   return cases::parse_suspension_case(json::parse(R"({
     "scene": "granular", "fidelity": "draft", "phi": 0.25, "Re_inf": 12,
-    "du_over_Uinf": )" + std::to_string(du_over_uinf) + R"(,
+    "du_over_Uinf": )" + std::to_string(du_over_uinf) +
+                                                  R"(,
     "protocol": {"stage1_min": 2, "stage1_max": 4, "stage2_settle": 2, "statistics": 10,
                  "stationarity_window": 1, "snapshot_every": 3, "sample_every": 0.1}
   })"));
@@ -49,7 +52,8 @@ TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
   EXPECT_EQ(a.result["observables"], b.result["observables"]);
   const long last = a.result["cost"]["steps"].get<long>();
   const auto read = [last](const fs::path& dir) {
-    return output::Hdf5File(output::snapshot_file(dir / "spheres", last), output::Hdf5File::Mode::read)
+    return output::Hdf5File(output::snapshot_file(dir / "spheres", last),
+                            output::Hdf5File::Mode::read)
         .read<double>("/position");
   };
   const auto pa = read(straight), pb = read(split);
@@ -74,7 +78,8 @@ TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
   EXPECT_GT(obs["events"]["escapes"].get<long>(), 100);
   EXPECT_LE(obs["events"]["worst_overlap"].get<double>(), 1e-9);
   // the window is the one asked for: statistics = 10 a/U_inf after settle
-  EXPECT_NEAR(obs["window"]["end"].get<double>() - obs["window"]["start"].get<double>(), 10.0, 0.01);
+  EXPECT_NEAR(obs["window"]["end"].get<double>() - obs["window"]["start"].get<double>(), 10.0,
+              0.01);
   // the mass-weighted size distribution sums to 1 and gives <n_a>
   double total = 0, mean = 0;
   const auto p = obs["size_distribution"].get<std::vector<double>>();
@@ -99,7 +104,8 @@ TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
   ASSERT_TRUE(fs::exists(dir / "spheres.xdmf"));
   // phi(x, t): every row averages to the realised solids fraction
   std::vector<hsize_t> shape;
-  const auto phi = output::Hdf5File(dir / "series.h5", output::Hdf5File::Mode::read).read<double>("/phi_x", &shape);
+  const auto phi = output::Hdf5File(dir / "series.h5", output::Hdf5File::Mode::read)
+                       .read<double>("/phi_x", &shape);
   ASSERT_EQ(shape.size(), 2u);
   for (hsize_t row = 0; row < shape[0]; row += 7) {
     double mean = 0;
