@@ -105,26 +105,26 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   const int cpus = slurm.value("cpus_per_task", 1);
 
   // What to do: claimable runs of the sweep (the tasks claim them for real).
-  std::vector<db::RunRecord> todo;
+  std::vector<db::RunRecord> to_submit;
   for (const db::RunRecord& r : db.runs(sweep.id)) {
     bool wanted = false;
     for (const std::string& s : l.states) wanted = wanted || r.status == s;
-    if (wanted && r.failures < sweep.max_attempts) todo.push_back(r);
+    if (wanted && r.failures < sweep.max_attempts) to_submit.push_back(r);
   }
-  if (todo.empty()) {
+  if (to_submit.empty()) {
     say(l.out, "slurm: nothing to run in sweep " + sweep.name);
     return sum;
   }
   const fs::path job_dir =
-      fs::path(todo.front().run_dir).parent_path() / "slurm" /
+      fs::path(to_submit.front().run_dir).parent_path() / "slurm" /
       (sweep.name + "-" + std::to_string(static_cast<long long>(db::unix_now())) + "-" +
        std::to_string(getpid()));
   fs::create_directories(job_dir);
   int tasks = 0;
-  for (std::size_t i = 0; i < todo.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
+  for (std::size_t i = 0; i < to_submit.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
     nlohmann::json task{{"states", l.states}, {"runs", nlohmann::json::array()}};
-    for (std::size_t j = i; j < std::min(todo.size(), i + static_cast<std::size_t>(per_task)); ++j)
-      task["runs"].push_back(todo[j].id);
+    for (std::size_t j = i; j < std::min(to_submit.size(), i + static_cast<std::size_t>(per_task)); ++j)
+      task["runs"].push_back(to_submit[j].id);
     std::ofstream(job_dir / ("task_" + std::to_string(tasks) + ".json")) << task.dump(2) << "\n";
   }
   const fs::path script = job_dir / "job.sh";
@@ -149,8 +149,8 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   if (rc != 0) throw std::runtime_error("sbatch failed (exit " + std::to_string(rc) + "): " + text);
   sum.job_id = text.substr(0, text.find_first_of(";\n"));
   sum.tasks = tasks;
-  sum.runs = static_cast<int>(todo.size());
-  say(l.out, "slurm: submitted job " + sum.job_id + ": " + std::to_string(todo.size()) +
+  sum.runs = static_cast<int>(to_submit.size());
+  say(l.out, "slurm: submitted job " + sum.job_id + ": " + std::to_string(to_submit.size()) +
                  " runs in " + std::to_string(tasks) + " array tasks (" + job_dir.string() + ")");
   if (!l.wait) return sum;
 

@@ -85,6 +85,45 @@ FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
   }
 }
 
+// Pointers p[i] with p[i][x] = population i (deviation) of cell (x, y, z) at
+// the current time: its own slot after an even number of steps, the
+// opposite slot of the upstream cell x - c_i otherwise. Valid for every x
+// when `even`, for the interior 0 < x < nx - 1 otherwise (the x shift of the
+// end cells wraps). Neighbour rows wrap by comparison, not division.
+template <class Real>
+void current_population_rows(const Real* base, long stride, int nx, int ny, int nz, int y, int z,
+                             bool even, const Real* (&p)[kQ]) {
+  const int ys[3] = {y == 0 ? ny - 1 : y - 1, y, y == ny - 1 ? 0 : y + 1};
+  const int zs[3] = {z == 0 ? nz - 1 : z - 1, z, z == nz - 1 ? 0 : z + 1};
+  for (int i = 0; i < kQ; ++i) {
+    if (even) {
+      p[i] = base + i * stride + static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+    } else {
+      const long up =
+          static_cast<long>(nx) * (ys[1 - cy[i]] + static_cast<long>(ny) * zs[1 - cz[i]]);
+      p[i] = base + opposite(i) * stride + up - cx[i];
+    }
+  }
+}
+
+// Density and velocity of one cell from its 19 deviations, with half of the
+// force density (hx, hy, hz) = F/2 added to the momentum (Guo's shift).
+template <class T>
+FLOCSIM_ALWAYS_INLINE void cell_moments(const T (&f)[kQ], T hx, T hy, T hz, T& rho, T& ux, T& uy,
+                                        T& uz) {
+  T drho = 0;
+#pragma GCC unroll 19
+  for (int i = 0; i < kQ; ++i) drho += f[i];
+  const T jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
+  const T jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
+  const T jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
+  rho = T(1) + drho;
+  const T inv = T(1) / rho;
+  ux = (jx + hx) * inv;
+  uy = (jy + hy) * inv;
+  uz = (jz + hz) * inv;
+}
+
 }  // namespace
 
 template <class Real>
@@ -234,26 +273,14 @@ template <class Real>
 void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, int y, int z,
                                                              double* density, double* ux,
                                                              double* uy, double* uz) const {
-  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
-  const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+  const int nx = extent_.nx;
   const bool even = time_step_ % 2 == 0;
-  // Population i of cell x is at p[i][x]: its own slot (even step) or the
-  // opposite slot of the upstream cell (odd step). Interior cells only; the
-  // two end cells of the row go through the wrapping path.
   const Real* p[kQ];
-  for (int i = 0; i < kQ; ++i) {
-    if (even) {
-      p[i] = storage(i) + row;
-    } else {
-      const long up = static_cast<long>(nx) *
-                      (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
-      p[i] = storage(opposite(i)) + up - cx[i];
-    }
-  }
-  const double bx = 0.5 * body_force_.x, by = 0.5 * body_force_.y, bz = 0.5 * body_force_.z;
+  current_population_rows(populations_.get(), stride_, nx, extent_.ny, extent_.nz, y, z, even, p);
+  const double hx = 0.5 * body_force_.x, hy = 0.5 * body_force_.y, hz = 0.5 * body_force_.z;
   for (int k = 0; k < count; ++k) {
     const int x = x0 + k;
-    if (!even && (x == 0 || x == nx - 1)) {
+    if (!even && (x == 0 || x == nx - 1)) {  // the end cells' upstream wraps in x
       const Macroscopic m = macroscopic_without_force_field(x, y, z);
       density[k] = m.density;
       ux[k] = m.velocity.x;
@@ -263,16 +290,7 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
     }
     double f[kQ];
     for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
-    double drho = 0;
-    for (int i = 0; i < kQ; ++i) drho += f[i];
-    const double jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
-    const double jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
-    const double jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
-    const double rho = 1.0 + drho, inv = 1.0 / rho;
-    density[k] = rho;
-    ux[k] = (jx + bx) * inv;
-    uy[k] = (jy + by) * inv;
-    uz[k] = (jz + bz) * inv;
+    cell_moments(f, hx, hy, hz, density[k], ux[k], uy[k], uz[k]);
   }
 }
 
@@ -281,23 +299,17 @@ void FluidLattice<Real>::macroscopic_field_without_force_field(Real* density, Re
                                                                Real* uz) const {
   const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
   const bool even = time_step_ % 2 == 0;
-  const Real bx = static_cast<Real>(0.5 * body_force_.x);
-  const Real by = static_cast<Real>(0.5 * body_force_.y);
-  const Real bz = static_cast<Real>(0.5 * body_force_.z);
+  const Real hx = static_cast<Real>(0.5 * body_force_.x);
+  const Real hy = static_cast<Real>(0.5 * body_force_.y);
+  const Real hz = static_cast<Real>(0.5 * body_force_.z);
+  const Real* const base = populations_.get();
+  const long stride = stride_;
 #pragma omp parallel for collapse(2) schedule(static)
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y) {
       const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
       const Real* p[kQ];
-      for (int i = 0; i < kQ; ++i) {
-        if (even) {
-          p[i] = storage(i) + row;
-        } else {
-          const long up = static_cast<long>(nx) *
-                          (wrap(y - cy[i], ny) + static_cast<long>(ny) * wrap(z - cz[i], nz));
-          p[i] = storage(opposite(i)) + up - cx[i];
-        }
-      }
+      current_population_rows(base, stride, nx, ny, nz, y, z, even, p);
       Real* const r = density + row;
       Real* const vx = ux + row;
       Real* const vy = uy + row;
@@ -307,17 +319,9 @@ void FluidLattice<Real>::macroscopic_field_without_force_field(Real* density, Re
 #pragma omp simd
       for (int x = x_begin; x < x_end; ++x) {
         Real f[kQ];
+#pragma GCC unroll 19
         for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
-        Real drho = 0;
-        for (int i = 0; i < kQ; ++i) drho += f[i];
-        const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
-        const Real jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
-        const Real jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
-        const Real rho = Real(1) + drho, inv = Real(1) / rho;
-        r[x] = rho;
-        vx[x] = (jx + bx) * inv;
-        vy[x] = (jy + by) * inv;
-        vz[x] = (jz + bz) * inv;
+        cell_moments(f, hx, hy, hz, r[x], vx[x], vy[x], vz[x]);
       }
       if (!even)
         for (int x : {0, nx - 1}) {
