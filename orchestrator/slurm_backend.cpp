@@ -123,7 +123,8 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   int tasks = 0;
   for (std::size_t i = 0; i < to_submit.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
     nlohmann::json task{{"states", l.states}, {"runs", nlohmann::json::array()}};
-    for (std::size_t j = i; j < std::min(to_submit.size(), i + static_cast<std::size_t>(per_task)); ++j)
+    for (std::size_t j = i; j < std::min(to_submit.size(), i + static_cast<std::size_t>(per_task));
+         ++j)
       task["runs"].push_back(to_submit[j].id);
     std::ofstream(job_dir / ("task_" + std::to_string(tasks) + ".json")) << task.dump(2) << "\n";
   }
