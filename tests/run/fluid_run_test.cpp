@@ -15,6 +15,7 @@
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/run/stop_signal.hpp"
+#include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
 namespace {
@@ -22,12 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path p =
-      fs::temp_directory_path() / ("flocsim_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  return p;
-}
+using flocsim::testing::fresh_dir;
 
 cases::FluidCase shear_wave_case(const std::string& precision) {
   return cases::parse_fluid_case(json::parse(R"({

@@ -9,6 +9,7 @@
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::output {
 namespace {
@@ -16,8 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(AtomicFile, ReplacesContentWithoutLeavingTemporaries) {
-  const fs::path dir = fs::temp_directory_path() / ("flocsim_atomic_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = flocsim::testing::fresh_dir("atomic");
   fs::create_directories(dir);
   write_file_atomically(dir / "a.json", "first\n");
   write_file_atomically(dir / "a.json", std::string(100000, 'x'));
@@ -31,8 +31,7 @@ TEST(AtomicFile, ReplacesContentWithoutLeavingTemporaries) {
 }
 
 TEST(FieldSnapshots, OneCompleteFilePerSnapshotWithXdmfIndex) {
-  const fs::path dir = fs::temp_directory_path() / ("flocsim_fields_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = flocsim::testing::fresh_dir("fields");
   const int nx = 5, ny = 3, nz = 2;
   std::vector<double> rho(nx * ny * nz), ux(rho.size()), uy(rho.size()), uz(rho.size());
   for (std::size_t i = 0; i < rho.size(); ++i) {
@@ -60,9 +59,7 @@ TEST(FieldSnapshots, OneCompleteFilePerSnapshotWithXdmfIndex) {
 }
 
 TEST(TemporaryFile, AnAbandonedWriteLeavesThePreviousFileAndNoDebris) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("flocsim_tmpfile_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = flocsim::testing::fresh_dir("tmpfile");
   fs::create_directories(dir);
   write_file_atomically(dir / "checkpoint.h5", "good");
   try {

@@ -14,6 +14,7 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
 namespace {
@@ -21,12 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path p =
-      fs::temp_directory_path() / ("flocsim_sphere_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  return p;
-}
+using flocsim::testing::fresh_dir;
 
 cases::SuspensionCase granular(double du_over_uinf) {
   return cases::parse_suspension_case(json::parse(R"({
@@ -40,7 +36,7 @@ cases::SuspensionCase granular(double du_over_uinf) {
 
 TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
   const cases::SuspensionCase c = granular(0.5);
-  const fs::path straight = fresh_dir("straight"), split = fresh_dir("split");
+  const fs::path straight = fresh_dir("sphere_straight"), split = fresh_dir("sphere_split");
   const RunReport a = run_sphere_case(c, {straight, false, true, 0});
   ASSERT_EQ(a.outcome, RunOutcome::completed);
   // stop inside stage 2 (after wells switched on: attached pairs are state)
