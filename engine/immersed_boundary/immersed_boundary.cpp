@@ -4,7 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -59,35 +62,117 @@ std::vector<std::vector<std::vector<int>>> make_colours(
   return colours;
 }
 
+// Vectors of 4 and 16 numbers (GCC/Clang vector extensions: with AVX-512 a
+// 16-float vector is one register, 16 doubles two).
+template <class Real>
+struct Simd {
+  typedef Real V4 __attribute__((vector_size(4 * sizeof(Real))));
+  typedef Real V16 __attribute__((vector_size(16 * sizeof(Real))));
+  template <class V>
+  static V load(const Real* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
+  template <class V>
+  static void store(Real* p, V v) {
+    std::memcpy(p, &v, sizeof v);
+  }
+};
+
+// The 27-cell stencil of one marker in a sphere's scratch box, shared by
+// interpolation and spreading. Every box cell holds four numbers, so a row of
+// four cells is one 16-number vector; a stencil row is three cells plus a
+// fourth with weight zero (the box rows have one spare cell for it), and each
+// operation is nine whole-row vector steps per marker.
+//   state:    (rho, v) per cell, v = u* + F / (2 rho): the velocity the collision sees;
+//   half_inv: 1 / (2 rho) per cell, four copies;
+//   force:    (0, F) per cell, F this sphere's force density.
+// w: the marker's 16 weight slots: x weights 0-2, y 3-5, z 6-8, slots 9-15 zero.
+// base: the marker's stencil corner as an offset in numbers (4 per cell).
+template <class Real>
+struct Stencil {
+  using V4 = typename Simd<Real>::V4;
+  using V16 = typename Simd<Real>::V16;
+  std::size_t offset[9];  // numbers from the corner to stencil row (b, c), index b + 3 c
+
+  Stencil(int row_cells, int box) {
+    for (int c = 0; c < 3; ++c)
+      for (int b = 0; b < 3; ++b)
+        offset[b + 3 * c] = 4 * static_cast<std::size_t>(row_cells) * (b + box * c);
+  }
+  // x weight of each of the 16 numbers of a stencil row (zero for the fourth cell).
+  static V16 row_weights(V16 w) {
+    return __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 15, 15, 15, 15);
+  }
+  // wy[b] wz[c] in slot b + 3 c.
+  static V16 yz_weights(V16 w) {
+    const V16 wy =
+        __builtin_shufflevector(w, w, 3, 4, 5, 3, 4, 5, 3, 4, 5, 15, 15, 15, 15, 15, 15, 15);
+    const V16 wz =
+        __builtin_shufflevector(w, w, 6, 6, 6, 7, 7, 7, 8, 8, 8, 15, 15, 15, 15, 15, 15, 15);
+    return wy * wz;
+  }
+
+  // Interpolated (rho, v) at the marker.
+  V4 interpolate(const Real* state, std::size_t base, V16 w) const {
+    const V16 wx = row_weights(w), wyz = yz_weights(w);
+    V16 acc = {};
+#pragma GCC unroll 9
+    for (int l = 0; l < 9; ++l)
+      acc += (wx * wyz[l]) * Simd<Real>::template load<V16>(state + base + offset[l]);
+    const V4 a = __builtin_shufflevector(acc, acc, 0, 1, 2, 3);
+    const V4 b = __builtin_shufflevector(acc, acc, 4, 5, 6, 7);
+    const V4 c = __builtin_shufflevector(acc, acc, 8, 9, 10, 11);
+    return a + b + c;
+  }
+
+  // Spreads (0, F_m dV) with the kernel: adds it to force and its
+  // velocity change, spread / (2 rho), to state.
+  // s points to the 4 numbers (0, F_m dV) (and 12 more, not used).
+  void spread(Real* force, Real* state, const Real* half_inv, std::size_t base, V16 w,
+              const Real* s) const {
+    const V16 s4 = Simd<Real>::template load<V16>(s);
+    const V16 ws = row_weights(w) *
+                   __builtin_shufflevector(s4, s4, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3);
+    const V16 wyz = yz_weights(w);
+#pragma GCC unroll 9
+    for (int l = 0; l < 9; ++l) {
+      const std::size_t r = base + offset[l];
+      const V16 t = ws * wyz[l];
+      Simd<Real>::store(force + r, Simd<Real>::template load<V16>(force + r) + t);
+      Simd<Real>::store(state + r, Simd<Real>::template load<V16>(state + r) +
+                                       t * Simd<Real>::template load<V16>(half_inv + r));
+    }
+  }
+};
+
 }  // namespace
 
-// Per-thread scratch space: a box of cells around one sphere and its markers.
+// Per-thread scratch space: a box of cells around one sphere and its markers,
+// in the lattice's precision (layout: see Stencil).
 template <class Real>
 struct ImmersedBoundary<Real>::Workspace {
+  using V4 = typename Simd<Real>::V4;
+  using V16 = typename Simd<Real>::V16;
   explicit Workspace(int box, int markers)
-      : cells(static_cast<std::size_t>(box) * box * box),
-        rho(cells),
-        ux(cells),
-        uy(cells),
-        uz(cells),
-        fx(cells, 0.0),
-        fy(cells, 0.0),
-        fz(cells, 0.0),
+      : row_cells(box + 1),
+        cells(static_cast<std::size_t>(row_cells) * box * box),
+        state(4 * cells, Real(0)),
+        half_inv(4 * cells, Real(1)),
+        force(4 * cells, Real(0)),
         base(static_cast<std::size_t>(markers)),
-        weights(static_cast<std::size_t>(markers) * 9),
+        weights(static_cast<std::size_t>(markers)),
         target(static_cast<std::size_t>(markers)),
         marker_force(static_cast<std::size_t>(markers)),
-        increment(static_cast<std::size_t>(markers)) {
-    touched.reserve(cells);
-  }
+        increment(static_cast<std::size_t>(markers) + 3) {}  // spread() reads 16 numbers
+  int row_cells;  // box + 1: room for the fourth cell of a stencil row at the far end
   std::size_t cells;
-  std::vector<double> rho, ux, uy, uz;  // u*: velocity without immersed-boundary force
-  std::vector<double> fx, fy, fz;       // this sphere's force density on the box
-  std::vector<int> touched;             // box cells read and written for this sphere
-  std::vector<int> global[3];           // wrapped lattice coordinate of each box row
-  std::vector<int> base;                // box index of each marker's stencil corner
-  std::vector<double> weights;          // 3 x 3 kernel weights of each marker
-  std::vector<Vec3> target, marker_force, increment;
+  std::vector<Real> state, half_inv, force;         // 4 numbers per cell
+  std::vector<int> global[3];                       // wrapped lattice coordinate of each box row
+  std::vector<std::size_t> base;                    // stencil corner of each marker (numbers)
+  std::vector<V16> weights;                         // kernel weights of each marker
+  std::vector<V4> target, marker_force, increment;  // (0, vector) per marker
 };
 
 template <class Real>
@@ -103,6 +188,9 @@ ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings) : se
   if (settings.iterations < 1 || settings.iterations > 20)
     throw std::invalid_argument("immersed boundary: iterations = " +
                                 std::to_string(settings.iterations) + ": must be in [1, 20]");
+  if (!(settings.input_radius <= 10000.0))
+    throw std::invalid_argument("immersed boundary: input_radius = " +
+                                std::to_string(settings.input_radius) + ": must be <= 10000 dx");
   const int n = marker_count(settings.input_radius, settings.marker_spacing);
   directions_ = fibonacci_sphere(n);
   marker_volume_ = immersed_boundary::marker_volume(settings.input_radius, n);
@@ -125,12 +213,17 @@ void ImmersedBoundary<Real>::zero_boxes(lattice::FluidLattice<Real>& fluid) {
     for (std::size_t b = 0; b < blocks.size(); ++b)
       for (int s : blocks[b]) {
         const auto& o = written_[static_cast<std::size_t>(s)];
+        const std::int16_t* rows = &written_rows_[2 * static_cast<std::size_t>(s) * B * B];
         for (int k = 0; k < B; ++k)
           for (int j = 0; j < B; ++j) {
+            const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+            if (i0 > i1) continue;
             const long row = fluid.cell_index(0, wrap(o[1] + j, e.ny), wrap(o[2] + k, e.nz));
-            for (int i = 0; i < B; ++i) {
-              const long c = row + wrap(o[0] + i, e.nx);
-              field[0][c] = field[1][c] = field[2][c] = Real(0);
+            for (int i = i0; i <= i1;) {
+              const int gx = wrap(o[0] + i, e.nx);
+              const int count = std::min(i1 - i + 1, e.nx - gx);
+              for (int d = 0; d < 3; ++d) std::fill_n(field[d] + row + gx, count, Real(0));
+              i += count;
             }
           }
       }
@@ -146,6 +239,8 @@ void ImmersedBoundary<Real>::remove(lattice::FluidLattice<Real>& fluid) {
 template <class Real>
 void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
                                    const spheres::SphereSet& spheres) {
+  using V4 = typename Simd<Real>::V4;
+  using V16 = typename Simd<Real>::V16;
   const lattice::Extent e = fluid.extent();
   const double ag = settings_.input_radius;
   const int length[3] = {e.nx, e.ny, e.nz};
@@ -156,7 +251,6 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
           " must exceed 2 a_g + 3 = " + std::to_string(2.0 * ag + 3.0) +
           " (a sphere's kernel cells must not meet its own periodic image)");
   if (!fluid.has_force_field()) fluid.enable_force_field();
-  zero_boxes(fluid);
 
   const std::size_t n = spheres.size();
   const int B = box_;
@@ -170,155 +264,211 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   for (std::size_t s = 0; s < n; ++s)
     for (int d = 0; d < 3; ++d)
       origins_[s][d] = static_cast<int>(std::floor(spheres.position[s][d] - ag)) - 2;
-  const auto colours = make_colours(origins_, B, e);
+  rows_.resize(2 * n * static_cast<std::size_t>(B) * B);
+  Real* field[3] = {fluid.force_field(0), fluid.force_field(1), fluid.force_field(2)};
 
+  // The lattice rows are cut in 16-cell chunks; need_ marks the chunks with
+  // cells that this apply() reads, held_ those holding force from the last one.
+  const int chunks = (e.nx + 15) / 16;
+  const int words = (chunks + 63) / 64;
+  const std::size_t lattice_rows = static_cast<std::size_t>(e.ny) * e.nz;
+  const bool zero_in_pass = !written_.empty() && held_.size() == lattice_rows * words;
+  if (!zero_in_pass) zero_boxes(fluid);
+  if (need_.size() != lattice_rows * words) need_.assign(lattice_rows * words, 0);
+  ustar_.resize(4 * static_cast<std::size_t>(e.cells()));
+
+  // The cells of every marker stencil: a stencil cell is within 1.5 of its
+  // marker in each direction, so it lies in the cube of half-width 1.5 around
+  // some point of the sphere |X - centre| = a_g. Per box row: the cells whose
+  // cube meets the ball of radius a_g (holes filled; this includes the inside,
+  // |r| < a_g + 1/2, that the momentum sums need).
+#pragma omp parallel for schedule(static)
+  for (std::size_t s = 0; s < n; ++s) {
+    const Vec3 centre = spheres.position[s];
+    const auto& lo = origins_[s];
+    std::int16_t* rows = &rows_[2 * s * B * B];
+    for (int k = 0; k < B; ++k) {
+      const double ez = std::max(0.0, std::abs(lo[2] + k - centre[2]) - 1.5);
+      const int gz = wrap(lo[2] + k, e.nz);
+      for (int j = 0; j < B; ++j) {
+        const double ey = std::max(0.0, std::abs(lo[1] + j - centre[1]) - 1.5);
+        const double left = ag * ag - ey * ey - ez * ez;
+        int i0 = 1, i1 = 0;
+        if (left >= 0) {
+          const double half = 1.5 + std::sqrt(left) + 1e-9;
+          i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
+          i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
+        }
+        rows[2 * (j + B * k)] = static_cast<std::int16_t>(i0);
+        rows[2 * (j + B * k) + 1] = static_cast<std::int16_t>(i1);
+        if (i0 > i1) continue;
+        std::uint64_t* word =
+            &need_[(static_cast<std::size_t>(wrap(lo[1] + j, e.ny)) + e.ny * gz) * words];
+        for (int i = i0; i <= i1;) {
+          const int gx = wrap(lo[0] + i, e.nx);
+          const int count = std::min(i1 - i + 1, e.nx - gx);
+          for (int c = gx / 16; c <= (gx + count - 1) / 16; ++c)
+            std::atomic_ref<std::uint64_t>(word[c / 64])
+                .fetch_or(std::uint64_t(1) << (c % 64), std::memory_order_relaxed);
+          i += count;
+        }
+      }
+    }
+  }
+  // One pass over the lattice rows in memory order: zero the force field on
+  // the chunks of the last apply() and compute u* on the chunks needed now
+  // (runs of chunks at once), so that the streams are read nearly in order.
+#pragma omp parallel for schedule(static)
+  for (std::size_t r = 0; r < lattice_rows; ++r) {
+    const int y = static_cast<int>(r % e.ny), z = static_cast<int>(r / e.ny);
+    const long row = fluid.cell_index(0, y, z);
+    if (zero_in_pass) {
+      std::uint64_t* held = &held_[r * words];
+      for (int c = 0; c < chunks; ++c)
+        if (held[c / 64] >> (c % 64) & 1) {
+          const int x0 = 16 * c, count = std::min(16, e.nx - x0);
+          for (int d = 0; d < 3; ++d) std::fill_n(field[d] + row + x0, count, Real(0));
+        }
+      std::fill_n(held, words, std::uint64_t(0));
+    }
+    const std::uint64_t* need = &need_[r * words];
+    Real* out = &ustar_[4 * static_cast<std::size_t>(row)];
+    for (int c = 0; c < chunks;) {
+      if (!(need[c / 64] >> (c % 64) & 1)) {
+        ++c;
+        continue;
+      }
+      int c1 = c + 1;
+      while (c1 < chunks && (need[c1 / 64] >> (c1 % 64) & 1)) ++c1;
+      const int x0 = 16 * c, x1 = std::min(e.nx, 16 * c1);
+      fluid.macroscopic_row_without_force_field(x0, x1 - x0, y, z, out + 4 * x0);
+      c = c1;
+    }
+  }
+  if (!zero_in_pass) held_.assign(lattice_rows * words, 0);
+  need_.swap(held_);  // need_ is all zero again
+  written_.clear();
+
+  const auto colours = make_colours(origins_, B, e);
   const int threads = omp_get_max_threads();
   if (static_cast<int>(workspaces_.size()) < threads)
     workspaces_.resize(static_cast<std::size_t>(threads));
   for (auto& w : workspaces_)
     if (!w) w = std::make_unique<Workspace>(B, markers);
 
-  const double ball = 4.0 / 3.0 * M_PI * std::pow(ag + 2.6, 3);
-  const bool use_field = static_cast<double>(n) * ball > 0.25 * static_cast<double>(e.cells());
-  if (use_field) {
-    const std::size_t cells = static_cast<std::size_t>(e.cells());
-    field_rho_.resize(cells);
-    field_ux_.resize(cells);
-    field_uy_.resize(cells);
-    field_uz_.resize(cells);
-    fluid.macroscopic_field_without_force_field(field_rho_.data(), field_ux_.data(),
-                                                field_uy_.data(), field_uz_.data());
-  }
   std::vector<double> slip_sq(settings_.measure_slip ? n : 0),
       slip_max(settings_.measure_slip ? n : 0);
-  Real* field[3] = {fluid.force_field(0), fluid.force_field(1), fluid.force_field(2)};
   const int iterations = settings_.iterations;
   const bool measure = settings_.measure_slip;
+  const Stencil<Real> stencil(B + 1, B);
+  const Real dVr = static_cast<Real>(dV);
+  const V4 vector_part = {0, 1, 1, 1};
 
   auto process = [&](Workspace& ws, int s) {
     const Vec3 centre = spheres.position[static_cast<std::size_t>(s)];
     const Vec3 up = spheres.velocity[static_cast<std::size_t>(s)];
     const Vec3 omega = spheres.angular_velocity[static_cast<std::size_t>(s)];
     const auto& lo = origins_[static_cast<std::size_t>(s)];
+    const std::int16_t* rows = &rows_[2 * static_cast<std::size_t>(s) * B * B];
+    const int R = ws.row_cells;
     for (int d = 0; d < 3; ++d) {
       ws.global[d].resize(static_cast<std::size_t>(B));
       for (int i = 0; i < B; ++i)
         ws.global[d][static_cast<std::size_t>(i)] = wrap(lo[d] + i, length[d]);
     }
-    // u* on every cell within a_g + 2.6 of the centre (all marker stencils,
-    // sqrt(3) * 1.5 < 2.6, and the inside of the sphere), row by row so that
-    // the 19 population streams are read in order.
-    const double reach_sq = (ag + 2.6) * (ag + 2.6);
-    for (int k = 0; k < B; ++k) {
-      const double rz = lo[2] + k - centre[2];
+    // Fetch the sphere's u* rows (and the force field lines it will add to)
+    // while the stencils are computed.
+    for (int k = 0; k < B; ++k)
       for (int j = 0; j < B; ++j) {
-        const double ry = lo[1] + j - centre[1];
-        const double left = reach_sq - ry * ry - rz * rz;
-        if (left <= 0) continue;
-        const double half = std::sqrt(left);
-        const int i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
-        const int i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
-        const int gy = ws.global[1][static_cast<std::size_t>(j)];
-        const int gz = ws.global[2][static_cast<std::size_t>(k)];
-        const int row = B * (j + B * k);
-        for (int i = i0; i <= i1; ++i) ws.touched.push_back(row + i);
-        if (use_field) {
-          const long grow = fluid.cell_index(0, gy, gz);
-          for (int i = i0; i <= i1; ++i) {
-            const long g = grow + ws.global[0][static_cast<std::size_t>(i)];
-            const std::size_t lc = static_cast<std::size_t>(row + i);
-            ws.rho[lc] = field_rho_[static_cast<std::size_t>(g)];
-            ws.ux[lc] = field_ux_[static_cast<std::size_t>(g)];
-            ws.uy[lc] = field_uy_[static_cast<std::size_t>(g)];
-            ws.uz[lc] = field_uz_[static_cast<std::size_t>(g)];
-          }
-          continue;
-        }
-        // Read the row in pieces that do not cross the periodic edge in x.
+        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+        if (i0 > i1) continue;
+        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
+                                           ws.global[2][static_cast<std::size_t>(k)]);
         for (int i = i0; i <= i1;) {
           const int gx = ws.global[0][static_cast<std::size_t>(i)];
           const int count = std::min(i1 - i + 1, length[0] - gx);
-          const std::size_t lc = static_cast<std::size_t>(row + i);
-          fluid.macroscopic_row_without_force_field(gx, count, gy, gz, &ws.rho[lc], &ws.ux[lc],
-                                                    &ws.uy[lc], &ws.uz[lc]);
+          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
+          for (int q = 0; q < 4 * count; q += 64 / static_cast<int>(sizeof(Real)))
+            __builtin_prefetch(from + q);
+          __builtin_prefetch(from + 4 * count - 1);
+          for (int d = 0; d < 3; ++d) {
+            for (int q = 0; q < count; q += 64 / static_cast<int>(sizeof(Real)))
+              __builtin_prefetch(field[d] + grow + gx + q, 1);
+            __builtin_prefetch(field[d] + grow + gx + count - 1, 1);
+          }
           i += count;
         }
       }
-    }
-    // Stencils and targets of the markers.
+    // Stencils (Roma weights, one square root per direction) and targets.
     for (int m = 0; m < markers; ++m) {
       const Vec3 r = ag * directions_[static_cast<std::size_t>(m)];
-      const Vec3 X = centre + r;
-      const KernelWeights kx = kernel_weights(X[0]), ky = kernel_weights(X[1]),
-                          kz = kernel_weights(X[2]);
-      const int b = (kx.first - lo[0]) + B * ((ky.first - lo[1]) + B * (kz.first - lo[2]));
-      ws.base[static_cast<std::size_t>(m)] = b;
-      double* w = &ws.weights[static_cast<std::size_t>(m) * 9];
-      for (int a = 0; a < 3; ++a) {
-        w[a] = kx.w[a];
-        w[3 + a] = ky.w[a];
-        w[6 + a] = kz.w[a];
+      int first[3];
+      double w[3][3];
+      for (int d = 0; d < 3; ++d) {
+        const double X = centre[d] + r[d];
+        const double nearest = std::nearbyint(X);
+        first[d] = static_cast<int>(nearest) - 1 - lo[d];
+        roma_weights(X - nearest, w[d]);
       }
-      ws.target[static_cast<std::size_t>(m)] = up + omega.cross(r);
-      ws.marker_force[static_cast<std::size_t>(m)].setZero();
+      ws.base[static_cast<std::size_t>(m)] =
+          4 * static_cast<std::size_t>(first[0] + R * (first[1] + B * first[2]));
+      V16 wm = {};
+      for (int d = 0; d < 3; ++d)
+        for (int a = 0; a < 3; ++a) wm[3 * d + a] = static_cast<Real>(w[d][a]);
+      ws.weights[static_cast<std::size_t>(m)] = wm;
+      const Vec3 t = up + omega.cross(r);
+      ws.target[static_cast<std::size_t>(m)] =
+          V4{0, static_cast<Real>(t[0]), static_cast<Real>(t[1]), static_cast<Real>(t[2])};
+      ws.marker_force[static_cast<std::size_t>(m)] = V4{};
     }
-    // Interpolated density and velocity (with the force so far) at marker m.
-    auto interpolate = [&](int m, double& rho, Vec3& u) {
-      const int b = ws.base[static_cast<std::size_t>(m)];
-      const double* w = &ws.weights[static_cast<std::size_t>(m) * 9];
-      double r = 0, vx = 0, vy = 0, vz = 0;
-      for (int c = 0; c < 3; ++c)
-        for (int bb = 0; bb < 3; ++bb) {
-          const double wyz = w[3 + bb] * w[6 + c];
-          const std::size_t row = static_cast<std::size_t>(b + B * (bb + B * c));
-          for (int a = 0; a < 3; ++a) {
-            const std::size_t cell = row + static_cast<std::size_t>(a);
-            const double wt = w[a] * wyz;
-            const double h = 0.5 / ws.rho[cell];
-            r += wt * ws.rho[cell];
-            vx += wt * (ws.ux[cell] + h * ws.fx[cell]);
-            vy += wt * (ws.uy[cell] + h * ws.fy[cell]);
-            vz += wt * (ws.uz[cell] + h * ws.fz[cell]);
-          }
+    // u* and 1/(2 rho) of the sphere's cells, from the pass.
+    for (int k = 0; k < B; ++k)
+      for (int j = 0; j < B; ++j) {
+        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+        if (i0 > i1) continue;
+        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
+                                           ws.global[2][static_cast<std::size_t>(k)]);
+        const std::size_t row = static_cast<std::size_t>(R) * (j + B * k);
+        for (int i = i0; i <= i1;) {  // pieces that do not cross the periodic edge in x
+          const int gx = ws.global[0][static_cast<std::size_t>(i)];
+          const int count = std::min(i1 - i + 1, length[0] - gx);
+          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
+          Real* to = &ws.state[4 * (row + i)];
+          for (int q = 0; q < 4 * count; ++q) to[q] = from[q];
+          i += count;
         }
-      rho = r;
-      u = {vx, vy, vz};
-    };
+        const Real* __restrict st = &ws.state[4 * row];
+        Real* __restrict h = &ws.half_inv[4 * row];
+#pragma omp simd
+        for (int i = i0; i <= i1; ++i) {
+          const Real v = Real(0.5) / st[4 * i];
+          h[4 * i] = h[4 * i + 1] = h[4 * i + 2] = h[4 * i + 3] = v;
+        }
+      }
+    // Multi-direct forcing: interpolate at all markers, then spread all (Jacobi).
+    Real* const state = ws.state.data();
     for (int it = 0; it < iterations; ++it) {
       for (int m = 0; m < markers; ++m) {
-        double rho;
-        Vec3 u;
-        interpolate(m, rho, u);
-        ws.increment[static_cast<std::size_t>(m)] =
-            2.0 * rho * (ws.target[static_cast<std::size_t>(m)] - u);
+        const std::size_t k = static_cast<std::size_t>(m);
+        const V4 u = stencil.interpolate(state, ws.base[k], ws.weights[k]);
+        const V4 dF = (Real(2) * u[0]) * (ws.target[k] - u) * vector_part;
+        ws.marker_force[k] += dF;
+        ws.increment[k] = dF * dVr;
       }
       for (int m = 0; m < markers; ++m) {
-        const Vec3 dF = ws.increment[static_cast<std::size_t>(m)];
-        ws.marker_force[static_cast<std::size_t>(m)] += dF;
-        const Vec3 spread = dF * dV;
-        const int b = ws.base[static_cast<std::size_t>(m)];
-        const double* w = &ws.weights[static_cast<std::size_t>(m) * 9];
-        for (int c = 0; c < 3; ++c)
-          for (int bb = 0; bb < 3; ++bb) {
-            const double wyz = w[3 + bb] * w[6 + c];
-            const std::size_t row = static_cast<std::size_t>(b + B * (bb + B * c));
-            for (int a = 0; a < 3; ++a) {
-              const std::size_t cell = row + static_cast<std::size_t>(a);
-              const double wt = w[a] * wyz;
-              ws.fx[cell] += wt * spread[0];
-              ws.fy[cell] += wt * spread[1];
-              ws.fz[cell] += wt * spread[2];
-            }
-          }
+        const std::size_t k = static_cast<std::size_t>(m);
+        stencil.spread(ws.force.data(), state, ws.half_inv.data(), ws.base[k], ws.weights[k],
+                       reinterpret_cast<const Real*>(&ws.increment[k]));
       }
     }
     if (measure) {
       double sq = 0, mx = 0;
       for (int m = 0; m < markers; ++m) {
-        double rho;
-        Vec3 u;
-        interpolate(m, rho, u);
-        const double err = (u - ws.target[static_cast<std::size_t>(m)]).norm();
+        const std::size_t k = static_cast<std::size_t>(m);
+        const V4 diff =
+            (stencil.interpolate(state, ws.base[k], ws.weights[k]) - ws.target[k]) * vector_part;
+        const double err = std::sqrt(double(diff[1]) * diff[1] + double(diff[2]) * diff[2] +
+                                     double(diff[3]) * diff[3]);
         sq += err * err;
         mx = std::max(mx, err);
       }
@@ -328,50 +478,73 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     // Force and torque on the sphere: the reaction of the marker forces.
     Vec3 F = Vec3::Zero(), T = Vec3::Zero();
     for (int m = 0; m < markers; ++m) {
-      const Vec3 Fm = ws.marker_force[static_cast<std::size_t>(m)] * dV;
+      const V4 f = ws.marker_force[static_cast<std::size_t>(m)];
+      const Vec3 Fm = Vec3(f[1], f[2], f[3]) * dV;
       F -= Fm;
       T -= (ag * directions_[static_cast<std::size_t>(m)]).cross(Fm);
     }
     force_[static_cast<std::size_t>(s)] = F;
     torque_[static_cast<std::size_t>(s)] = T;
-    // Momentum of the liquid inside, with the velocity the collision will see.
-    Vec3 P = Vec3::Zero(), Lin = Vec3::Zero();
+    // Momentum of the liquid inside, rho v = rho u* + F/2: the collision's.
+    double P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     const double reach = ag + 0.5;
     for (int k = 0; k < B; ++k) {
       const double rz = lo[2] + k - centre[2];
       if (std::abs(rz) >= reach) continue;
       for (int j = 0; j < B; ++j) {
         const double ry = lo[1] + j - centre[1];
-        if (rz * rz + ry * ry >= reach * reach) continue;
-        for (int i = 0; i < B; ++i) {
+        const double left = reach * reach - ry * ry - rz * rz;
+        if (left <= 0) continue;
+        const double half = std::sqrt(left);
+        const int i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
+        const int i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
+        const Real* st = &ws.state[4 * static_cast<std::size_t>(R) * (j + B * k)];
+        double px = 0, py = 0, pz = 0, lx = 0, ly = 0, lz = 0;
+#pragma omp simd reduction(+ : px, py, pz, lx, ly, lz)
+        for (int i = i0; i <= i1; ++i) {
           const double rx = lo[0] + i - centre[0];
           const double dist = std::sqrt(rx * rx + ry * ry + rz * rz);
-          const double w = std::min(1.0, reach - dist);
-          if (w <= 0) continue;
-          const std::size_t lc = static_cast<std::size_t>(i + B * (j + B * k));
-          const Vec3 j_cell(ws.rho[lc] * ws.ux[lc] + 0.5 * ws.fx[lc],
-                            ws.rho[lc] * ws.uy[lc] + 0.5 * ws.fy[lc],
-                            ws.rho[lc] * ws.uz[lc] + 0.5 * ws.fz[lc]);
-          P += w * j_cell;
-          Lin += w * Vec3(rx, ry, rz).cross(j_cell);
+          const double w = std::clamp(reach - dist, 0.0, 1.0);
+          const double rho = st[4 * i];
+          const double jx = rho * st[4 * i + 1], jy = rho * st[4 * i + 2], jz = rho * st[4 * i + 3];
+          px += w * jx;
+          py += w * jy;
+          pz += w * jz;
+          lx += w * (ry * jz - rz * jy);
+          ly += w * (rz * jx - rx * jz);
+          lz += w * (rx * jy - ry * jx);
         }
+        P[0] += px, P[1] += py, P[2] += pz;
+        L[0] += lx, L[1] += ly, L[2] += lz;
       }
     }
-    momentum[static_cast<std::size_t>(s)] = P;
-    angular[static_cast<std::size_t>(s)] = Lin;
-    // Add this sphere's force to the lattice field and reset the scratch box.
-    for (int cell : ws.touched) {
-      const std::size_t lc = static_cast<std::size_t>(cell);
-      const int i = cell % B, j = (cell / B) % B, k = cell / (B * B);
-      const long g = fluid.cell_index(ws.global[0][static_cast<std::size_t>(i)],
-                                      ws.global[1][static_cast<std::size_t>(j)],
-                                      ws.global[2][static_cast<std::size_t>(k)]);
-      field[0][g] += static_cast<Real>(ws.fx[lc]);
-      field[1][g] += static_cast<Real>(ws.fy[lc]);
-      field[2][g] += static_cast<Real>(ws.fz[lc]);
-      ws.fx[lc] = ws.fy[lc] = ws.fz[lc] = 0.0;
-    }
-    ws.touched.clear();
+    momentum[static_cast<std::size_t>(s)] = Vec3(P[0], P[1], P[2]);
+    angular[static_cast<std::size_t>(s)] = Vec3(L[0], L[1], L[2]);
+    // Add this sphere's force to the lattice field, row by row, and clear the
+    // scratch force (nonzero only on the rows' cells).
+    for (int k = 0; k < B; ++k)
+      for (int j = 0; j < B; ++j) {
+        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+        if (i0 > i1) continue;
+        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
+                                           ws.global[2][static_cast<std::size_t>(k)]);
+        Real* __restrict f = &ws.force[4 * static_cast<std::size_t>(R) * (j + B * k)];
+        for (int i = i0; i <= i1;) {
+          const int gx = ws.global[0][static_cast<std::size_t>(i)];
+          const int count = std::min(i1 - i + 1, length[0] - gx);
+          Real* __restrict gxp = field[0] + grow + gx - i;
+          Real* __restrict gyp = field[1] + grow + gx - i;
+          Real* __restrict gzp = field[2] + grow + gx - i;
+#pragma omp simd
+          for (int c = i; c < i + count; ++c) {
+            gxp[c] += f[4 * c + 1];
+            gyp[c] += f[4 * c + 2];
+            gzp[c] += f[4 * c + 3];
+          }
+          i += count;
+        }
+        for (int q = 4 * i0; q < 4 * (i1 + 1); ++q) f[q] = Real(0);
+      }
   };
 
 #pragma omp parallel
@@ -384,6 +557,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     }
   }
   written_ = origins_;
+  written_rows_.swap(rows_);
   internal_momentum_change_.assign(n, Vec3::Zero());
   internal_angular_change_.assign(n, Vec3::Zero());
   if (have_previous)

@@ -46,6 +46,7 @@
 // take whole blocks of one colour at a time and write the force field without
 // atomics.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -122,11 +123,18 @@ class ImmersedBoundary {
   std::vector<Vec3> internal_momentum_change_, internal_angular_change_;
   std::vector<std::array<int, 3>> origins_;  // lowest corner of each sphere's cell box (unwrapped)
   std::vector<std::array<int, 3>> written_;  // boxes holding force from the last apply()
+  // Per sphere and box row (j + box k): first and last box cell of the row that
+  // the sphere reads and writes (first > last: none); rows_ for this apply(),
+  // written_rows_ for the boxes in written_.
+  std::vector<std::int16_t> rows_, written_rows_;
+  // u* = (rho, u without the immersed-boundary force) of the cells the
+  // spheres need, four numbers per cell in lattice order, filled by one pass
+  // over the lattice rows per apply(). The rows are cut in 16-cell chunks, one
+  // bit each: need_ marks the chunks the spheres read (all zero between calls),
+  // held_ the chunks holding force from the last apply() (that pass zeroes them).
+  std::vector<Real> ustar_;
+  std::vector<std::uint64_t> need_, held_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
-  // u* of every cell, filled by one streaming pass when the spheres' cell
-  // balls cover more than a quarter of the lattice (dense suspensions);
-  // otherwise each sphere reads its own cells from the populations.
-  std::vector<Real> field_rho_, field_ux_, field_uy_, field_uz_;
   double rms_slip_ = 0, max_slip_ = 0;
 };
 

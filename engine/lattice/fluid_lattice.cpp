@@ -295,6 +295,40 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
 }
 
 template <class Real>
+void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, int y, int z,
+                                                             Real* rho_u) const {
+  const int nx = extent_.nx;
+  const bool even = time_step_ % 2 == 0;
+  const Real* p[kQ];
+  current_population_rows(populations_.get(), stride_, nx, extent_.ny, extent_.nz, y, z, even, p);
+  const Real hx = static_cast<Real>(0.5 * body_force_.x);
+  const Real hy = static_cast<Real>(0.5 * body_force_.y);
+  const Real hz = static_cast<Real>(0.5 * body_force_.z);
+  int k_begin = 0, k_end = count;
+  // At an odd step the upstream of the end cells wraps in x: slot x - c_x is
+  // read through p[i][x] as p[i][x - c_x + c_x], so wrap x - c_x first.
+  const auto edge = [&](int k) {
+    const int x = x0 + k;
+    Real f[kQ];
+    for (int i = 0; i < kQ; ++i) {
+      int up = x - cx[i];
+      up = up < 0 ? up + nx : (up >= nx ? up - nx : up);
+      f[i] = p[i][up + cx[i]];
+    }
+    cell_moments(f, hx, hy, hz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
+  };
+  if (!even && count > 0 && x0 == 0) edge(k_begin++);
+  if (!even && k_end > k_begin && x0 + count == nx) edge(--k_end);
+#pragma omp simd
+  for (int k = k_begin; k < k_end; ++k) {
+    Real f[kQ];
+#pragma GCC unroll 19
+    for (int i = 0; i < kQ; ++i) f[i] = p[i][x0 + k];
+    cell_moments(f, hx, hy, hz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
+  }
+}
+
+template <class Real>
 void FluidLattice<Real>::macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy,
                                                                Real* uz) const {
   const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;

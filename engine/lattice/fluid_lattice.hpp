@@ -93,6 +93,9 @@ class FluidLattice {
   // (inside the box, no wrap in x), written to density[k], ux[k], uy[k], uz[k].
   void macroscopic_row_without_force_field(int x0, int count, int y, int z, double* density,
                                            double* ux, double* uy, double* uz) const;
+  // The same in the lattice's precision, interleaved: cell x0 + k gets
+  // (density, ux, uy, uz) at rho_u[4 k .. 4 k + 3] (the immersed boundary's layout).
+  void macroscopic_row_without_force_field(int x0, int count, int y, int z, Real* rho_u) const;
   // The same for every cell, in one streaming pass over the populations
   // (threads over rows), into arrays of length cells() indexed by cell_index.
   void macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy, Real* uz) const;
