@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "engine/calibration/shipped_table.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/spheres/sphere_set.hpp"
@@ -191,11 +192,22 @@ void CalibrationTable::save(const std::string& filename) const {
 CalibrationTable CalibrationTable::load(const std::string& filename) {
   std::ifstream in(filename);
   if (!in) throw std::runtime_error("cannot read calibration table " + filename);
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse(text.str(), filename);
+}
+
+const CalibrationTable& CalibrationTable::shipped() {
+  static const CalibrationTable table = parse(kShippedTableJson, "the shipped calibration table");
+  return table;
+}
+
+CalibrationTable CalibrationTable::parse(const std::string& json_text, const std::string& origin) {
   nlohmann::json j;
   try {
-    in >> j;
+    j = nlohmann::json::parse(json_text);
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("calibration table " + filename + ": " + e.what());
+    throw std::runtime_error("calibration table " + origin + ": " + e.what());
   }
   CalibrationTable t;
   t.note = j.value("note", "");

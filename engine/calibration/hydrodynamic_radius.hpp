@@ -79,6 +79,11 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
 class CalibrationTable {
  public:
   static CalibrationTable load(const std::string& filename);
+  // The table as JSON text; `origin` names it in errors.
+  static CalibrationTable parse(const std::string& json_text, const std::string& origin);
+  // The table shipped with this build (engine/calibration/hydrodynamic_radius.json
+  // at build time, compiled in).
+  static const CalibrationTable& shipped();
   void save(const std::string& filename) const;
   void add(const CalibrationEntry& entry);
   const std::vector<CalibrationEntry>& entries() const { return entries_; }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/case/case_support.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -90,6 +91,13 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     }
   }
   c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
+  c.input_radius_given = num.has("input_radius");
+  if (c.input_radius_given)
+    c.input_radius = num.number(
+        "input_radius",
+        {.at_least = a - 1,
+         .at_most = a,
+         .why = "(markers sit inside the hydrodynamic radius a_over_dx, by less than 1 dx)"});
   num.finish();
   if (c.settling_velocity > kMaxSettlingVelocity)
     throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) +
@@ -101,6 +109,23 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     c.warnings.push_back("viscosity = " + format_value(c.viscosity) +
                          " is below the smallest tested (" +
                          format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
+
+  if (c.scene != "granular" && !c.input_radius_given) {
+    // a_g for this a from the shipped calibration (nearest calibrated viscosity)
+    try {
+      const auto& entry = calibration::CalibrationTable::shipped().lookup(a, c.viscosity);
+      c.input_radius = entry.input_radius;
+      c.calibration_viscosity = entry.viscosity;
+    } catch (const std::out_of_range& e) {
+      throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
+                       " Or give numerics.input_radius (the marker radius a_g) yourself.");
+    }
+    if (std::abs(std::log(c.calibration_viscosity / c.viscosity)) > std::log(2.0))
+      c.warnings.push_back("the hydrodynamic-radius calibration nearest to viscosity = " +
+                           format_value(c.viscosity) + " was made at " +
+                           format_value(c.calibration_viscosity) +
+                           "; `flocsim calibrate --viscosity` makes one for this viscosity");
+  }
 
   InputReader pr = root.object("protocol");
   const Range duration{.at_least = 0, .at_most = 1e5};
@@ -188,6 +213,7 @@ nlohmann::json SuspensionCase::to_json() const {
   j["L_over_a"] = length_over_a;
   j["L_over_W"] = length_over_width;
   j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
+  if (input_radius_given) j["numerics"]["input_radius"] = input_radius;
   j["protocol"] = {{"stage1_min", stage1_min},
                    {"stage1_max", stage1_max},
                    {"stage2_settle", stage2_settle},
@@ -215,7 +241,12 @@ nlohmann::json SuspensionCase::derived_json() const {
           {"well_width", well_width},
           {"liquid_body_force", liquid_body_force},
           {"sphere_net_gravity", sphere_net_gravity},
-          {"Mach_U_inf", settling_velocity * std::sqrt(3.0)}};
+          {"Mach_U_inf", settling_velocity * std::sqrt(3.0)},
+          {"input_radius", input_radius},
+          {"input_radius_from", input_radius_given    ? std::string("numerics.input_radius")
+                                : scene == "granular" ? std::string("unused (no liquid)")
+                                                      : "shipped calibration at nu = " +
+                                                            format_value(calibration_viscosity)}};
 }
 
 }  // namespace flocsim::cases

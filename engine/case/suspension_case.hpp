@@ -49,6 +49,12 @@ struct SuspensionCase {
   double radius_cells = 6;  // hydrodynamic radius a / dx
   double viscosity = 0;     // lattice nu (derived when not given)
   double trt_magic = 0.25;
+  // Marker radius a_g of the immersed boundary, which gives hydrodynamic
+  // radius a: numerics.input_radius, or looked up in the shipped calibration
+  // table (engine/calibration) at the nearest calibrated viscosity.
+  double input_radius = 0;
+  bool input_radius_given = false;
+  double calibration_viscosity = 0;  // viscosity of the table entry used
 
   // ---- protocol (durations in a / U_inf) -------------------------------------
   double stage1_min = 20;     // du = 0 stage: at least this long ...

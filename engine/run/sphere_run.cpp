@@ -7,20 +7,29 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <random>
 
+#include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/events/direct_interactions.hpp"
+#include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lubrication/radial_lubrication.hpp"
 #include "engine/observables/aggregates.hpp"
+#include "engine/observables/liquid_averages.hpp"
 #include "engine/observables/pair_structure.hpp"
+#include "engine/observables/reference_correlations.hpp"
 #include "engine/observables/suspension_averages.hpp"
 #include "engine/output/atomic_file.hpp"
+#include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/output/sphere_snapshots.hpp"
 #include "engine/placement/random_placement.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/stop_signal.hpp"
+#include "engine/spheres/sphere_dynamics.hpp"
 
 #ifndef FLOCSIM_VERSION
 #define FLOCSIM_VERSION "0.1.0"
@@ -38,23 +47,57 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Columns of the time series, sampled every protocol.sample_every a/U_inf.
-const std::vector<std::string> kColumns = {"step",
-                                           "time",
-                                           "stage",
-                                           "contacts_per_sphere",
-                                           "mean_aggregate_size",
-                                           "granular_temperature",
-                                           "Re_T",
-                                           "kinetic_energy",
-                                           "well_energy",
-                                           "collisions"};
+// ---- which modules a scene composes ------------------------------------------
+struct SceneModules {
+  bool liquid = false;       // lattice liquid + immersed boundary
+  bool spheres_move = true;  // sphere equations of motion (else held still)
+  bool contacts = false;     // event-driven collisions and square well
+  bool lubrication = false;  // radial lubrication below s0
+};
 
-std::size_t column(const std::string& name) {
-  const auto it = std::find(kColumns.begin(), kColumns.end(), name);
-  if (it == kColumns.end()) throw std::logic_error("no time-series column " + name);
-  return static_cast<std::size_t>(it - kColumns.begin());
+SceneModules modules_of(const std::string& scene) {
+  if (scene == "suspension") return {true, true, true, true};
+  if (scene == "fixed-array") return {true, false, false, false};
+  if (scene == "single-sphere") return {true, true, false, false};
+  return {false, true, true, false};  // granular
 }
+
+// ---- time series -------------------------------------------------------------
+// Columns sampled every protocol.sample_every a/U_inf; scenes with a liquid add
+// the settling observables of SPEC section 4.
+std::vector<std::string> columns_of(const SceneModules& m) {
+  std::vector<std::string> cols = {"step",
+                                   "time",
+                                   "stage",
+                                   "contacts_per_sphere",
+                                   "mean_aggregate_size",
+                                   "granular_temperature",
+                                   "Re_T",
+                                   "kinetic_energy",
+                                   "well_energy",
+                                   "collisions"};
+  if (m.liquid)
+    cols.insert(cols.end(), {"U_over_Uinf", "U", "F", "Re", "liquid_velocity", "sphere_velocity",
+                             "momentum_balance"});
+  return cols;
+}
+
+struct Series {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> data;
+
+  explicit Series(std::vector<std::string> columns)
+      : names(std::move(columns)), data(names.size()) {}
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) throw std::logic_error("no time-series column " + name);
+    return static_cast<std::size_t>(it - names.begin());
+  }
+  const std::vector<double>& operator[](const std::string& name) const {
+    return data[column(name)];
+  }
+  std::size_t samples() const { return data[0].size(); }
+};
 
 // Microstructure accumulated over the statistics window (paper Fig. 2):
 // g(r) with bins of 0.05a up to 5a (or just under half the box), h(theta)
@@ -71,7 +114,26 @@ int phi_slabs(const cases::SuspensionCase& c) {
   return std::max(1, static_cast<int>(std::lround(c.box.nx / c.radius_cells)));
 }
 
-// Everything that evolves: what a checkpoint holds.
+// The liquid and its coupling to the spheres (every scene but granular).
+template <class Real>
+struct Liquid {
+  lattice::FluidLattice<Real> fluid;
+  immersed_boundary::ImmersedBoundary<Real> ib;
+  spheres::SphereDynamicsSettings dynamics;
+  std::vector<std::uint8_t> solid;  // scratch of the liquid averages
+
+  explicit Liquid(const cases::SuspensionCase& c)
+      : fluid(c.box, {c.viscosity, c.trt_magic}), ib({c.input_radius, 0.7, 2, false}) {
+    const double volume = static_cast<double>(c.box.cells());
+    dynamics.external =
+        spheres::settling_forces(static_cast<std::size_t>(c.sphere_count), c.radius_cells,
+                                 c.density_ratio, volume, c.gravity);
+    fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
+    fluid.enable_force_field();
+  }
+};
+
+// Everything that evolves besides the lattice: what a checkpoint holds.
 struct RunState {
   spheres::SphereSet spheres;
   long step = 0;
@@ -79,11 +141,16 @@ struct RunState {
   long stage2_start = -1;      // step at which du was switched on
   long statistics_start = -1;  // step after which samples enter the averages
   bool stage1_stationary = false;
-  std::vector<std::vector<double>> series = std::vector<std::vector<double>>(kColumns.size());
+  Series series;
   std::vector<double> size_distribution_sum;  // sum of p(n) over statistics samples
   observables::PairStructure microstructure{1, 1, 1, 1};
   std::vector<double> phi_x;  // phi(x, t): one row of slabs per sample
   double wall_s = 0;          // before this invocation
+  // momentum balance of liquid + spheres (scenes whose spheres move freely)
+  double momentum_initial = 0;
+  bool momentum_initial_set = false;
+
+  explicit RunState(const SceneModules& m) : series(columns_of(m)) {}
 };
 
 struct Durations {  // protocol in time steps
@@ -107,6 +174,13 @@ Durations durations(const cases::SuspensionCase& c) {
   return d;
 }
 
+// Stage 2 (du at its target, then stage2_settle before statistics) exists
+// only where a square well acts; elsewhere statistics begin where stage 1
+// becomes stationary.
+bool has_stage2(const cases::SuspensionCase& c, const SceneModules& m) {
+  return m.contacts && c.escape_velocity > 0;
+}
+
 std::vector<double> flatten(const std::vector<Vec3>& v) {
   std::vector<double> out;
   for (const auto& x : v) out.insert(out.end(), {x.x(), x.y(), x.z()});
@@ -119,8 +193,11 @@ std::vector<Vec3> unflatten(const std::vector<double>& v) {
   return out;
 }
 
+// ---- checkpoint ----------------------------------------------------------------
+template <class Real>
 void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const RunState& s,
-                      const events::DirectInteractions& contacts, double wall_s) {
+                      const events::DirectInteractions& contacts, const Liquid<Real>* liquid,
+                      double wall_s) {
   output::TemporaryFile tmp(dir / "checkpoint.h5");
   {
     output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
@@ -140,9 +217,23 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
                                                 static_cast<std::int64_t>(k.neighbour_rebuilds),
                                                 static_cast<std::int64_t>(k.steps)};
     f.write("/event_counters", {counters.size()}, counters.data());
+    if (liquid) {
+      // the lattice populations, and the inside-liquid momenta whose change
+      // the first resumed step feeds to the sphere equations
+      f.create_group("/fluid");
+      const std::vector<hsize_t> shape = {static_cast<hsize_t>(liquid->fluid.extent().cells())};
+      for (int i = 0; i < d3q19::kQ; ++i)
+        f.write("/fluid/population_deviation_" + std::to_string(i), shape,
+                liquid->fluid.storage(i));
+      f.set_attribute("/fluid", "time_step", static_cast<std::int64_t>(liquid->fluid.time_step()));
+      f.write("/spheres/internal_momentum", {n, 3}, flatten(liquid->ib.internal_momentum()).data());
+      f.write("/spheres/internal_angular_momentum", {n, 3},
+              flatten(liquid->ib.internal_angular_momentum()).data());
+    }
     f.create_group("/series");
-    for (std::size_t col = 0; col < kColumns.size(); ++col)
-      f.write("/series/" + kColumns[col], {s.series[col].size()}, s.series[col].data());
+    for (std::size_t col = 0; col < s.series.names.size(); ++col)
+      f.write("/series/" + s.series.names[col], {s.series.data[col].size()},
+              s.series.data[col].data());
     f.write("/size_distribution_sum", {s.size_distribution_sum.size()},
             s.size_distribution_sum.data());
     const auto m = s.microstructure.accumulated();
@@ -155,19 +246,23 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
                     static_cast<std::int64_t>(m.configurations));
     f.write("/phi_x", {s.phi_x.size()}, s.phi_x.data());
     f.set_attribute("/", "case", c.to_json().dump());
+    f.set_attribute("/", "precision", std::string(sizeof(Real) == 8 ? "double" : "float"));
     f.set_attribute("/", "step", static_cast<std::int64_t>(s.step));
     f.set_attribute("/", "stage", static_cast<std::int64_t>(s.stage));
     f.set_attribute("/", "stage2_start", static_cast<std::int64_t>(s.stage2_start));
     f.set_attribute("/", "statistics_start", static_cast<std::int64_t>(s.statistics_start));
     f.set_attribute("/", "stage1_stationary", static_cast<std::int64_t>(s.stage1_stationary));
+    f.set_attribute("/", "momentum_initial", s.momentum_initial);
+    f.set_attribute("/", "momentum_initial_set", static_cast<std::int64_t>(s.momentum_initial_set));
     f.set_attribute("/", "wall_s", wall_s);
     f.close();
   }
   tmp.commit();
 }
 
+template <class Real>
 void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunState& s,
-                     events::DirectInteractions& contacts) {
+                     events::DirectInteractions& contacts, Liquid<Real>* liquid) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
   if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
     throw input::InputError(
@@ -175,6 +270,10 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   s.spheres.position = unflatten(f.read<double>("/spheres/position"));
   s.spheres.velocity = unflatten(f.read<double>("/spheres/velocity"));
   s.spheres.angular_velocity = unflatten(f.read<double>("/spheres/angular_velocity"));
+  if (s.spheres.position.size() != static_cast<std::size_t>(c.sphere_count))
+    throw std::runtime_error(file.string() + ": holds " +
+                             std::to_string(s.spheres.position.size()) + " spheres, the case has " +
+                             std::to_string(c.sphere_count));
   const auto pairs = f.read<std::int64_t>("/spheres/attached_pairs");
   std::vector<std::pair<int, int>> attached;
   for (std::size_t k = 0; k + 1 < pairs.size(); k += 2)
@@ -187,8 +286,20 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   counters.edge_bounces = static_cast<std::uint64_t>(k[3]);
   counters.neighbour_rebuilds = static_cast<std::uint64_t>(k[4]);
   counters.steps = static_cast<std::uint64_t>(k[5]);
-  for (std::size_t col = 0; col < kColumns.size(); ++col)
-    s.series[col] = f.read<double>("/series/" + kColumns[col]);
+  if (liquid) {
+    for (int i = 0; i < d3q19::kQ; ++i) {
+      const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
+      if (static_cast<long>(data.size()) != liquid->fluid.extent().cells())
+        throw std::runtime_error(file.string() + ": population array has the wrong size");
+      std::copy(data.begin(), data.end(), liquid->fluid.storage(i));
+    }
+    liquid->fluid.set_time_step(f.attribute_int("/fluid", "time_step"));
+    liquid->ib.set_internal_momenta(
+        unflatten(f.read<double>("/spheres/internal_momentum")),
+        unflatten(f.read<double>("/spheres/internal_angular_momentum")));
+  }
+  for (std::size_t col = 0; col < s.series.names.size(); ++col)
+    s.series.data[col] = f.read<double>("/series/" + s.series.names[col]);
   s.size_distribution_sum = f.read<double>("/size_distribution_sum");
   observables::PairStructure::Accumulated m;
   m.g_counts = f.read<double>("/microstructure/g_counts");
@@ -198,15 +309,13 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   m.configurations = f.attribute_int("/microstructure", "configurations");
   s.microstructure.restore(m);
   s.phi_x = f.read<double>("/phi_x");
-  if (s.spheres.position.size() != static_cast<std::size_t>(c.sphere_count))
-    throw std::runtime_error(file.string() + ": holds " +
-                             std::to_string(s.spheres.position.size()) + " spheres, the case has " +
-                             std::to_string(c.sphere_count));
   s.step = f.attribute_int("/", "step");
   s.stage = static_cast<int>(f.attribute_int("/", "stage"));
   s.stage2_start = f.attribute_int("/", "stage2_start");
   s.statistics_start = f.attribute_int("/", "statistics_start");
   s.stage1_stationary = f.attribute_int("/", "stage1_stationary") != 0;
+  s.momentum_initial = f.attribute_double("/", "momentum_initial");
+  s.momentum_initial_set = f.attribute_int("/", "momentum_initial_set") != 0;
   s.wall_s = f.attribute_double("/", "wall_s");
   if (s.stage == 2) contacts.set_escape_velocity(c.escape_velocity);
   contacts.set_attached_pairs(attached);
@@ -217,8 +326,8 @@ void write_series(const fs::path& dir, const RunState& s, int slabs) {
   output::TemporaryFile tmp(dir / "series.h5");
   {
     output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
-    for (std::size_t col = 0; col < kColumns.size(); ++col)
-      f.write("/" + kColumns[col], {s.series[col].size()}, s.series[col].data());
+    for (std::size_t col = 0; col < s.series.names.size(); ++col)
+      f.write("/" + s.series.names[col], {s.series.data[col].size()}, s.series.data[col].data());
     // phi(x, t): rows are samples (times in /time), columns slabs of width L / slabs
     const auto slab_count = static_cast<hsize_t>(slabs);
     f.write("/phi_x", {s.phi_x.size() / slab_count, slab_count}, s.phi_x.data());
@@ -227,14 +336,22 @@ void write_series(const fs::path& dir, const RunState& s, int slabs) {
   tmp.commit();
 }
 
+template <class Real>
+void write_fields(const fs::path& dir, const lattice::FluidLattice<Real>& fluid) {
+  std::vector<double> rho, ux, uy, uz;
+  fluid.macroscopic_fields(rho, ux, uy, uz);
+  const auto e = fluid.extent();
+  output::write_field_snapshot(dir / "fields",
+                               {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
+}
+
 // The samples of one column taken after the statistics started.
 std::vector<double> statistics_window(const RunState& s, const std::string& column_name) {
-  const std::size_t step_col = 0;
-  const std::size_t col = column(column_name);
+  const auto& steps = s.series["step"];
+  const auto& values = s.series[column_name];
   std::vector<double> out;
-  for (std::size_t k = 0; k < s.series[step_col].size(); ++k)
-    if (s.series[step_col][k] > static_cast<double>(s.statistics_start))
-      out.push_back(s.series[col][k]);
+  for (std::size_t k = 0; k < steps.size(); ++k)
+    if (steps[k] > static_cast<double>(s.statistics_start)) out.push_back(values[k]);
   return out;
 }
 
@@ -250,18 +367,46 @@ nlohmann::json steady(const std::vector<double>& samples) {
           {"error_reliable", a.error_reliable}};
 }
 
-}  // namespace
-
-const std::vector<std::string>& runnable_sphere_scenes() {
-  static const std::vector<std::string> scenes = {"granular"};
-  return scenes;
+// Initial positions and velocities of a fresh start.
+void place_spheres(const cases::SuspensionCase& c, const SceneModules& m,
+                   const spheres::PeriodicBox& box, spheres::SphereSet& s) {
+  s.resize(static_cast<std::size_t>(c.sphere_count));
+  if (c.scene == "single-sphere") {
+    s.position[0] = 0.5 * box.length;
+    return;
+  }
+  s.position = placement::place_randomly({c.sphere_count, c.radius_cells, 0.0, c.seed}, box);
+  if (m.liquid) return;  // spheres and liquid start at rest
+  // granular gas: Maxwellian velocities with U_inf per component, no net momentum
+  std::mt19937_64 rng(c.seed + 1);
+  std::normal_distribution<double> maxwell(0.0, c.settling_velocity);
+  Vec3 mean = Vec3::Zero();
+  for (auto& v : s.velocity) mean += (v = Vec3(maxwell(rng), maxwell(rng), maxwell(rng)));
+  mean /= static_cast<double>(c.sphere_count);
+  for (auto& v : s.velocity) v -= mean;
 }
 
-RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
-  if (std::find(runnable_sphere_scenes().begin(), runnable_sphere_scenes().end(), c.scene) ==
-      runnable_sphere_scenes().end())
-    throw input::InputError("scene = \"" + c.scene +
-                            "\": must be one of the scenes this build runs: granular, fluid");
+// Fastest sphere speed accepted before the run is called unstable: beyond
+// 0.3 (Ma ~ 0.5) the lattice cannot carry the flow around it.
+constexpr double kMaxSphereSpeed = 0.3;
+
+// Empty when healthy, else what went wrong.
+std::string health(const spheres::SphereSet& s, double liquid_mass) {
+  if (!std::isfinite(liquid_mass)) return "the liquid mass is no longer finite";
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double v = s.velocity[i].norm();
+    if (!std::isfinite(v) || !std::isfinite(s.angular_velocity[i].norm()))
+      return "sphere " + std::to_string(i) + " has a non-finite velocity";
+    if (v > kMaxSphereSpeed)
+      return "sphere " + std::to_string(i) + " moves at " + std::to_string(v) +
+             " lattice units (limit " + std::to_string(kMaxSphereSpeed) + ")";
+  }
+  return {};
+}
+
+template <class Real>
+RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
+  const SceneModules modules = modules_of(c.scene);
   const StartMode start = prepare_output_directory(o.out_dir, o.resume);
   RunLog log(o.out_dir / "run.log", o.quiet);
   if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
@@ -270,14 +415,22 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   const Clock::time_point t_start = Clock::now();
   const Durations d = durations(c);
   const spheres::PeriodicBox box{Vec3(c.box.nx, c.box.ny, c.box.nz)};
+  const bool stage2 = has_stage2(c, modules);
 
   // ---- modules of the scene ---------------------------------------------------
   events::DirectInteractions contacts({.restitution = c.restitution,
                                        .friction = c.friction,
                                        .escape_velocity = 0.0,  // stage 1: du = 0
                                        .well_width = c.well_width});
+  const lubrication::RadialLubrication lubrication(
+      {.viscosity = c.viscosity,
+       .liquid_density = 1.0,
+       .onset_gap = c.lubrication_onset_over_a,
+       .saturation_gap = c.lubrication_saturation_over_a});
+  std::unique_ptr<Liquid<Real>> liquid;
+  if (modules.liquid) liquid = std::make_unique<Liquid<Real>>(c);
 
-  RunState s;
+  RunState s(modules);
   s.spheres.radius = c.radius_cells;
   s.spheres.density_ratio = c.density_ratio;
   s.size_distribution_sum.assign(static_cast<std::size_t>(c.sphere_count) + 1, 0.0);
@@ -285,66 +438,142 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   const int slabs = phi_slabs(c);
   const fs::path checkpoint = o.out_dir / "checkpoint.h5";
   if (start == StartMode::from_checkpoint) {
-    read_checkpoint(checkpoint, c, s, contacts);
+    read_checkpoint(checkpoint, c, s, contacts, liquid.get());
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(s.step));
   } else {
-    s.spheres.resize(static_cast<std::size_t>(c.sphere_count));
-    s.spheres.position =
-        placement::place_randomly({c.sphere_count, c.radius_cells, 0.0, c.seed}, box);
-    // granular gas: Maxwellian velocities with U_inf per component, no net momentum
-    std::mt19937_64 rng(c.seed + 1);
-    std::normal_distribution<double> maxwell(0.0, c.settling_velocity);
-    Vec3 mean = Vec3::Zero();
-    for (auto& v : s.spheres.velocity) mean += (v = Vec3(maxwell(rng), maxwell(rng), maxwell(rng)));
-    mean /= static_cast<double>(c.sphere_count);
-    for (auto& v : s.spheres.velocity) v -= mean;
+    place_spheres(c, modules, box, s.spheres);
   }
   log.info(std::string("flocsim ") + FLOCSIM_VERSION + " " + c.scene + " scene: " +
            std::to_string(c.sphere_count) + " spheres of radius " + std::to_string(c.radius_cells) +
+           (modules.liquid ? " (markers at a_g = " + std::to_string(c.input_radius) + ")" : "") +
            " in " + std::to_string(c.box.nx) + " x " + std::to_string(c.box.ny) + " x " +
            std::to_string(c.box.nz) + ", phi = " + std::to_string(c.phi_realised) +
-           ", a/U_inf = " + std::to_string(c.convective_time) + " steps");
+           ", a/U_inf = " + std::to_string(c.convective_time) + " steps" +
+           (modules.liquid ? std::string(", ") + (sizeof(Real) == 8 ? "double" : "float") +
+                                 " lattice, nu = " + std::to_string(c.viscosity)
+                           : std::string()) +
+           ", " + std::to_string(omp_get_max_threads()) + " threads");
 
   auto expected_total = [&] {
-    if (s.stage == 1) return std::max(s.step, d.stage1_max) + d.settle + d.statistics;
+    const long after_stage1 = stage2 ? d.settle + d.statistics : d.statistics;
+    if (s.stage == 1 && s.statistics_start < 0)
+      return std::max(s.step, d.stage1_max) + after_stage1;
+    if (s.statistics_start >= 0) return s.statistics_start + d.statistics;
     return s.stage2_start + d.settle + d.statistics;
   };
-  ProgressReporter progress(log, o.out_dir / "progress.json", s.step, expected_total(), 0,
+  const long cells = modules.liquid ? c.box.cells() : 0;
+  ProgressReporter progress(log, o.out_dir / "progress.json", s.step, expected_total(), cells,
                             c.progress_every_s);
-  double events_s = 0, observables_s = 0, output_s = 0, checkpoint_s = 0;
+  double fluid_s = 0, ib_s = 0, spheres_s = 0, lubrication_s = 0, events_s = 0;
+  double observables_s = 0, output_s = 0, checkpoint_s = 0;
   Clock::time_point last_checkpoint = Clock::now();
+  long last_good_checkpoint = start == StartMode::from_checkpoint ? s.step : -1;
   const long first_step = s.step;
   const double mass = s.spheres.mass();
-  // what must become stationary in stage 1: the granular temperature
-  const std::size_t signal_column = column("granular_temperature");
+  // what must become stationary in stage 1: the slip velocity where there is
+  // a liquid, the granular temperature in a granular gas
+  const std::string signal = modules.liquid ? "U_over_Uinf" : "granular_temperature";
+  const double a = c.radius_cells;
   bool done = s.statistics_start >= 0 && s.step - s.statistics_start >= d.statistics;
+  double worst_momentum_drift = 0;
+
+  auto fail = [&](const std::string& what) {
+    RunReport r;
+    r.outcome = RunOutcome::failed;
+    r.message = "numerical blow-up at step " + std::to_string(s.step) +
+                " (t U_inf/a = " + std::to_string(s.step / c.convective_time) + "): " + what +
+                ". " +
+                (last_good_checkpoint >= 0
+                     ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint) +
+                           ") is kept in " + checkpoint.string() + ". "
+                     : std::string("No checkpoint had been written yet. ")) +
+                "Likely causes: U_inf too high for the Mach limit, a viscosity too small for "
+                "the resolution, or a density ratio near 1.";
+    log.error(r.message);
+    return r;
+  };
 
   while (!done) {
+    // ---- one time step: the modules of the scene, in order -------------------
     Clock::time_point t0 = Clock::now();
-    contacts.advance(s.spheres, box, 1.0);
-    events_s += seconds_since(t0);
+    if (liquid) {
+      liquid->ib.apply(liquid->fluid, s.spheres);  // no-slip forces at the current state
+      ib_s += seconds_since(t0);
+      t0 = Clock::now();
+      liquid->fluid.step();
+      fluid_s += seconds_since(t0);
+      t0 = Clock::now();
+      if (modules.spheres_move)
+        spheres::advance_velocities(
+            s.spheres,
+            {liquid->ib.force(), liquid->ib.torque(), liquid->ib.internal_momentum_change(),
+             liquid->ib.internal_angular_momentum_change()},
+            liquid->dynamics);
+      spheres_s += seconds_since(t0);
+    }
+    if (modules.lubrication) {
+      t0 = Clock::now();
+      lubrication.apply(s.spheres, box, 1.0);
+      lubrication_s += seconds_since(t0);
+    }
+    t0 = Clock::now();
+    if (modules.contacts) {
+      contacts.advance(s.spheres, box, 1.0);  // moves the spheres, with collisions and wells
+      events_s += seconds_since(t0);
+    } else if (modules.spheres_move) {
+      spheres::advance_positions(s.spheres, box);
+      spheres_s += seconds_since(t0);
+    }
     ++s.step;
 
     if (s.step % d.sample == 0) {
       t0 = Clock::now();
-      const auto agg = observables::find_aggregates(s.spheres.position, box,
-                                                    2.0 * (c.radius_cells + c.well_width));
+      const auto agg =
+          observables::find_aggregates(s.spheres.position, box, 2.0 * (a + c.well_width));
       const double T = observables::granular_temperature(s.spheres.velocity);
       double kinetic = 0;
-      for (const auto& v : s.spheres.velocity) kinetic += 0.5 * mass * v.squaredNorm();
-      const std::vector<double> row = {static_cast<double>(s.step),
-                                       s.step / c.convective_time,
-                                       static_cast<double>(s.stage),
-                                       agg.contacts_per_sphere,
-                                       agg.mean_size,
-                                       T,
-                                       std::sqrt(T) * 2 * c.radius_cells / c.viscosity,
-                                       kinetic,
-                                       contacts.well_energy(s.spheres),
-                                       static_cast<double>(contacts.counters().collisions)};
-      for (std::size_t col = 0; col < row.size(); ++col) s.series[col].push_back(row[col]);
-      const auto phi =
-          observables::slab_solids_fraction(s.spheres.position, c.radius_cells, box, slabs);
+      Vec3 sphere_mean = Vec3::Zero();
+      for (const auto& v : s.spheres.velocity) {
+        kinetic += 0.5 * mass * v.squaredNorm();
+        sphere_mean += v;
+      }
+      sphere_mean /= static_cast<double>(s.spheres.size());
+      std::vector<double> row = {static_cast<double>(s.step),
+                                 s.step / c.convective_time,
+                                 static_cast<double>(s.stage),
+                                 agg.contacts_per_sphere,
+                                 agg.mean_size,
+                                 T,
+                                 std::sqrt(T) * 2 * a / c.viscosity,
+                                 kinetic,
+                                 contacts.well_energy(s.spheres),
+                                 static_cast<double>(contacts.counters().collisions)};
+      if (liquid) {
+        const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
+        const std::string sick = health(s.spheres, l.mass);
+        if (!sick.empty()) return fail(sick);
+        const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
+                                                                c.phi_realised);
+        // lattice momentum + sum (m_p u_p - P_in): constant (sphere_dynamics.hpp)
+        double balance = l.lattice_momentum_x;
+        for (std::size_t i = 0; i < s.spheres.size(); ++i)
+          balance += mass * s.spheres.velocity[i].x() - liquid->ib.internal_momentum()[i].x();
+        if (!s.momentum_initial_set) {
+          // not 0: the first step has no inside-momentum change, while the
+          // inside liquid already carries the half body force f/2 (a constant)
+          s.momentum_initial = balance;
+          s.momentum_initial_set = true;
+        }
+        const double drift = modules.spheres_move ? balance - s.momentum_initial : 0.0;
+        row.insert(row.end(),
+                   {U / c.settling_velocity, U,
+                    observables::dimensionless_drag(liquid->dynamics.external.liquid_body_force.x(),
+                                                    a, c.phi_realised, c.viscosity, U),
+                    U * 2 * a / c.viscosity, l.mean_velocity_x, sphere_mean.x(), drift});
+        worst_momentum_drift = std::max(worst_momentum_drift, std::abs(drift));
+      }
+      for (std::size_t col = 0; col < row.size(); ++col) s.series.data[col].push_back(row[col]);
+      const auto phi = observables::slab_solids_fraction(s.spheres.position, a, box, slabs);
       s.phi_x.insert(s.phi_x.end(), phi.begin(), phi.end());
       if (s.statistics_start >= 0) {
         for (std::size_t n = 0; n < agg.size_distribution.size(); ++n)
@@ -354,19 +583,24 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
       observables_s += seconds_since(t0);
 
       // ---- protocol -----------------------------------------------------------
-      if (s.stage == 1 && s.step >= d.stage1_min) {
-        const bool stationary =
-            observables::is_stationary(s.series[signal_column], d.window_samples);
+      if (s.stage == 1 && s.statistics_start < 0 && s.step >= d.stage1_min) {
+        const bool stationary = observables::is_stationary(s.series[signal], d.window_samples);
         if (stationary || s.step >= d.stage1_max) {
-          s.stage = 2;
-          s.stage2_start = s.step;
           s.stage1_stationary = stationary;
-          contacts.set_escape_velocity(c.escape_velocity);
-          if (c.escape_velocity > 0) contacts.attach_pairs_within_well(s.spheres, box);
-          log.info(
-              "stage 2 at t U_inf/a = " + std::to_string(s.step / c.convective_time) +
-              (stationary ? " (stationary)" : " (stage1_max reached before the detector fired)") +
-              ": du/U_inf = " + std::to_string(c.du_over_uinf));
+          const std::string why =
+              stationary ? " (stationary)" : " (stage1_max reached before the detector fired)";
+          if (stage2) {
+            s.stage = 2;
+            s.stage2_start = s.step;
+            contacts.set_escape_velocity(c.escape_velocity);
+            contacts.attach_pairs_within_well(s.spheres, box);
+            log.info("stage 2 at t U_inf/a = " + std::to_string(s.step / c.convective_time) + why +
+                     ": du/U_inf = " + std::to_string(c.du_over_uinf));
+          } else {
+            s.statistics_start = s.step;
+            log.info("statistics from t U_inf/a = " + std::to_string(s.step / c.convective_time) +
+                     why);
+          }
           progress.set_steps_total(expected_total());
         }
       } else if (s.stage == 2 && s.statistics_start < 0 && s.step - s.stage2_start >= d.settle) {
@@ -377,8 +611,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     }
     if (d.snapshot > 0 && (s.step % d.snapshot == 0 || done)) {
       t0 = Clock::now();
-      const auto agg = observables::find_aggregates(s.spheres.position, box,
-                                                    2.0 * (c.radius_cells + c.well_width));
+      const auto agg =
+          observables::find_aggregates(s.spheres.position, box, 2.0 * (a + c.well_width));
       output::write_sphere_snapshot(o.out_dir / "spheres", s.step, s.step / c.convective_time,
                                     s.spheres, agg.aggregate_of);
       output_s += seconds_since(t0);
@@ -389,10 +623,14 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
         seconds_since(last_checkpoint) >= c.checkpoint_every_s ||
         (o.checkpoint_every_steps > 0 && s.step % o.checkpoint_every_steps == 0);
     if (!done && (stop_now || checkpoint_due)) {
+      // only a healthy state is checkpointed: the last good one is never replaced by a bad one
+      const std::string sick = health(s.spheres, liquid ? liquid->fluid.total_mass() : 0.0);
+      if (!sick.empty()) return fail(sick);
       t0 = Clock::now();
-      write_checkpoint(o.out_dir, c, s, contacts, s.wall_s + seconds_since(t_start));
+      write_checkpoint(o.out_dir, c, s, contacts, liquid.get(), s.wall_s + seconds_since(t_start));
       checkpoint_s += seconds_since(t0);
       last_checkpoint = Clock::now();
+      last_good_checkpoint = s.step;
       if (stop_now) {
         progress.finish(s.step);
         log.info("stopped at step " + std::to_string(s.step) +
@@ -402,34 +640,77 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
         return r;
       }
     }
-    if (!s.series[0].empty() && s.step % d.sample == 0) {
-      char extra[160];
-      std::snprintf(extra, sizeof extra, "stage %d | t U/a %.1f | C_sph %.3f | <n_a> %.3f", s.stage,
-                    s.step / c.convective_time, s.series[column("contacts_per_sphere")].back(),
-                    s.series[column("mean_aggregate_size")].back());
+    if (s.series.samples() > 0 && s.step % d.sample == 0) {
+      char extra[200];
+      const std::string phase = s.statistics_start >= 0 ? "statistics"
+                                : s.stage == 2          ? "stage 2"
+                                                        : "stage 1";
+      if (liquid)
+        std::snprintf(extra, sizeof extra, "%s | t U/a %.1f | U/U_inf %.3f | C_sph %.3f",
+                      phase.c_str(), s.step / c.convective_time, s.series["U_over_Uinf"].back(),
+                      s.series["contacts_per_sphere"].back());
+      else
+        std::snprintf(extra, sizeof extra, "%s | t U/a %.1f | C_sph %.3f | <n_a> %.3f",
+                      phase.c_str(), s.step / c.convective_time,
+                      s.series["contacts_per_sphere"].back(),
+                      s.series["mean_aggregate_size"].back());
       progress.update(s.step, extra);
     }
   }
   progress.finish(s.step);
 
-  // ---- result.json -------------------------------------------------------------
+  // ---- output and result.json ----------------------------------------------------
+  Clock::time_point t0 = Clock::now();
   write_series(o.out_dir, s, slabs);
+  if (liquid) write_fields(o.out_dir, liquid->fluid);
+  output_s += seconds_since(t0);
   nlohmann::json obs;
   obs["contacts_per_sphere"] = steady(statistics_window(s, "contacts_per_sphere"));
   obs["n_a_mean"] = steady(statistics_window(s, "mean_aggregate_size"));
   obs["granular_temperature"] = steady(statistics_window(s, "granular_temperature"));
   obs["Re_T"] = steady(statistics_window(s, "Re_T"));
-  const auto samples = statistics_window(s, "kinetic_energy");
-  const auto wells = statistics_window(s, "well_energy");
-  const auto collisions = statistics_window(s, "collisions");
-  if (samples.size() >= 2) {
-    // with e = 1 and no liquid, kinetic + well energy is conserved
-    const double e0 = samples.front() + wells.front(), e1 = samples.back() + wells.back();
-    obs["energy_relative_change"] = (e1 - e0) / e0;
-    const auto times = statistics_window(s, "time");
-    const double span = times.back() - times.front();
-    obs["collisions_per_sphere_per_convective_time"] =
-        (collisions.back() - collisions.front()) / c.sphere_count / span;
+  if (liquid) {
+    obs["U_over_Uinf"] = steady(statistics_window(s, "U_over_Uinf"));
+    obs["U"] = steady(statistics_window(s, "U"));
+    obs["F"] = steady(statistics_window(s, "F"));
+    obs["Re"] = steady(statistics_window(s, "Re"));
+    const double phi = c.phi_realised;
+    const double re = obs["Re"]["mean"].get<double>();
+    nlohmann::json ref;
+    ref["beetstra_F_at_measured_Re"] = observables::beetstra_drag(phi, re);
+    ref["beetstra_normalisation"] =
+        "F = F_h / (6 pi mu a U), F_h = f V_p (1/phi - 1), U superficial, Re = 2aU/nu";
+    if (c.scene == "suspension") {
+      ref["richardson_zaki_U_over_Uinf"] =
+          observables::richardson_zaki_velocity_ratio(phi, c.reynolds_inf);
+      ref["richardson_zaki_exponent"] = observables::richardson_zaki_exponent(c.reynolds_inf);
+    }
+    if (c.scene == "single-sphere" && c.box.nx == c.box.ny && c.box.ny == c.box.nz) {
+      // creeping-flow hindrance of the simple cubic array the periodic box makes
+      ref["sangani_acrivos_K"] = calibration::sangani_acrivos_drag(2 * a / c.box.nx);
+    }
+    obs["references"] = ref;
+    if (modules.spheres_move)
+      obs["momentum_balance"] = {
+          {"worst_drift", worst_momentum_drift},
+          {"relative_to_sphere_momentum",
+           worst_momentum_drift /
+               std::max(1e-300, std::abs(mass * c.sphere_count * c.settling_velocity))},
+          {"what", "lattice momentum + sum (m_p u_p - P_in), x, minus its first sample"}};
+  }
+  if (!liquid) {
+    const auto samples = statistics_window(s, "kinetic_energy");
+    const auto wells = statistics_window(s, "well_energy");
+    const auto collisions = statistics_window(s, "collisions");
+    if (samples.size() >= 2) {
+      // with e = 1 and no liquid, kinetic + well energy is conserved
+      const double e0 = samples.front() + wells.front(), e1 = samples.back() + wells.back();
+      obs["energy_relative_change"] = (e1 - e0) / e0;
+      const auto times = statistics_window(s, "time");
+      const double span = times.back() - times.front();
+      obs["collisions_per_sphere_per_convective_time"] =
+          (collisions.back() - collisions.front()) / c.sphere_count / span;
+    }
   }
   std::vector<double> p(s.size_distribution_sum.size());
   const double n_samples = static_cast<double>(statistics_window(s, "step").size());
@@ -440,7 +721,7 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   {
     std::vector<double> r = s.microstructure.radial_bin_centres(),
                         theta = s.microstructure.angular_bin_centres();
-    for (double& x : r) x /= c.radius_cells;
+    for (double& x : r) x /= a;
     obs["g_r"] = {{"r_over_a", r}, {"g", s.microstructure.radial_distribution()}};
     obs["h_theta"] = {{"theta", theta},
                       {"h", s.microstructure.angular_distribution()},
@@ -451,7 +732,8 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                    {"end", s.step / c.convective_time},
                    {"unit", "a/U_inf"},
                    {"samples", static_cast<long>(n_samples)}};
-  obs["stage2_start"] = s.stage2_start / c.convective_time;
+  obs["stage2_start"] =
+      s.stage2_start >= 0 ? nlohmann::json(s.stage2_start / c.convective_time) : nullptr;
   obs["stage1_stationary"] = s.stage1_stationary;
   const auto& k = contacts.counters();
   obs["events"] = {{"collisions", k.collisions},
@@ -462,22 +744,33 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                    {"worst_overlap", contacts.worst_overlap()}};
 
   const double wall = seconds_since(t_start);
+  const long steps_here = s.step - first_step;
+  nlohmann::json cost = {{"wall_s", s.wall_s + wall},
+                         {"wall_s_this_invocation", wall},
+                         {"steps", s.step},
+                         {"steps_this_invocation", steps_here},
+                         {"threads", omp_get_max_threads()}};
+  nlohmann::json modules_s = {{"events", events_s},
+                              {"observables", observables_s},
+                              {"output", output_s},
+                              {"checkpoint", checkpoint_s}};
+  if (liquid) {
+    modules_s["fluid"] = fluid_s;
+    modules_s["immersed_boundary"] = ib_s;
+    modules_s["spheres"] = spheres_s;
+    modules_s["lubrication"] = lubrication_s;
+    const double updates = static_cast<double>(steps_here) * static_cast<double>(cells);
+    cost["MLUPS_fluid"] = fluid_s > 0 ? updates / fluid_s / 1e6 : 0.0;
+    cost["MLUPS_full_step"] = wall > 0 ? updates / wall / 1e6 : 0.0;
+  }
+  cost["modules_s"] = modules_s;
   nlohmann::json result;
   result["status"] = "completed";
   result["flocsim_version"] = FLOCSIM_VERSION;
   result["case"] = c.to_json();
   result["derived"] = c.derived_json();
   result["observables"] = obs;
-  result["cost"] = {{"wall_s", s.wall_s + wall},
-                    {"wall_s_this_invocation", wall},
-                    {"steps", s.step},
-                    {"steps_this_invocation", s.step - first_step},
-                    {"threads", omp_get_max_threads()},
-                    {"modules_s",
-                     {{"events", events_s},
-                      {"observables", observables_s},
-                      {"output", output_s},
-                      {"checkpoint", checkpoint_s}}}};
+  result["cost"] = cost;
   result["completed_at"] = utc_timestamp();
   output::write_file_atomically(o.out_dir / "result.json", result.dump(2) + "\n");
   std::error_code ec;
@@ -489,6 +782,23 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   r.outcome = RunOutcome::completed;
   r.result = std::move(result);
   return r;
+}
+
+}  // namespace
+
+const std::vector<std::string>& runnable_sphere_scenes() {
+  static const std::vector<std::string> scenes = {"suspension", "fixed-array", "single-sphere",
+                                                  "granular"};
+  return scenes;
+}
+
+RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
+  if (std::find(runnable_sphere_scenes().begin(), runnable_sphere_scenes().end(), c.scene) ==
+      runnable_sphere_scenes().end())
+    throw input::InputError("scene = \"" + c.scene +
+                            "\": must be one of suspension, fixed-array, single-sphere, "
+                            "granular, fluid");
+  return c.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
 }
 
 }  // namespace flocsim::run

@@ -82,7 +82,7 @@ TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
       parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}});
   EXPECT_DOUBLE_EQ(c.viscosity, 0.005);
   EXPECT_NEAR(c.settling_velocity, 0.03, 1e-15);
-  EXPECT_TRUE(c.warnings.empty());
+  for (const auto& w : c.warnings) EXPECT_EQ(w.find("smallest tested"), std::string::npos) << w;
 }
 
 TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
@@ -127,6 +127,35 @@ TEST(SuspensionCase, BadInputsAreNamed) {
   d = base;
   d["density_ratio"] = 0.5;
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("density_ratio = 0.5"), HasSubstr("settle")));
+}
+
+// The marker radius a_g comes from the shipped calibration table (values in
+// engine/calibration/hydrodynamic_radius.json: a = 6 at nu = 0.02 and 1/6), or
+// from numerics.input_radius; an uncalibrated a is refused before any work.
+TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
+  SuspensionCase c = parse_suspension_case(
+      {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"viscosity", 0.02}}}});
+  EXPECT_NEAR(c.input_radius, 5.5789, 1e-4);
+  EXPECT_DOUBLE_EQ(c.calibration_viscosity, 0.02);
+  c = parse_suspension_case(
+      {{"scene", "single-sphere"}, {"Re_inf", 1}, {"numerics", {{"viscosity", 0.15}}}});  // 1/6
+  EXPECT_NEAR(c.input_radius, 5.6120, 1e-4);
+  c = parse_suspension_case({{"scene", "fixed-array"},
+                             {"phi", 0.2},
+                             {"numerics", {{"a_over_dx", 5}, {"input_radius", 4.6}}}});
+  EXPECT_DOUBLE_EQ(c.input_radius, 4.6);
+  EXPECT_EQ(c.to_json()["numerics"]["input_radius"], 4.6);
+  const json uncalibrated = {
+      {"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 5}}}};
+  EXPECT_THAT(refusal(uncalibrated), AllOf(HasSubstr("numerics.a_over_dx = 5"), HasSubstr("a = 6"),
+                                           HasSubstr("input_radius")));
+  const json too_small = {{"scene", "suspension"},
+                          {"phi", 0.2},
+                          {"numerics", {{"a_over_dx", 5}, {"input_radius", 3.5}}}};
+  EXPECT_THAT(refusal(too_small), AllOf(HasSubstr("input_radius = 3.5"), HasSubstr(">= 4")));
+  // a granular gas has no liquid and needs no calibration
+  EXPECT_NO_THROW(parse_suspension_case(
+      {{"scene", "granular"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 5}}}}));
 }
 
 }  // namespace

@@ -1,0 +1,78 @@
+#include "engine/observables/liquid_averages.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+
+namespace flocsim::observables {
+
+void mark_solid_cells(const lattice::Extent& e, const std::vector<spheres::Vec3>& centres,
+                      double radius, std::vector<std::uint8_t>& solid) {
+  solid.assign(static_cast<std::size_t>(e.cells()), 0);
+  const int reach = static_cast<int>(std::ceil(radius));
+  const double r2 = radius * radius;
+  auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  for (const auto& c : centres) {
+    const int x0 = static_cast<int>(std::floor(c.x())), y0 = static_cast<int>(std::floor(c.y())),
+              z0 = static_cast<int>(std::floor(c.z()));
+    for (int z = z0 - reach; z <= z0 + reach + 1; ++z) {
+      const double dz = z - c.z();
+      for (int y = y0 - reach; y <= y0 + reach + 1; ++y) {
+        const double dy = y - c.y();
+        if (dy * dy + dz * dz > r2) continue;
+        const long row = (static_cast<long>(wrap(z, e.nz)) * e.ny + wrap(y, e.ny)) * e.nx;
+        for (int x = x0 - reach; x <= x0 + reach + 1; ++x) {
+          const double dx = x - c.x();
+          if (dx * dx + dy * dy + dz * dz <= r2)
+            solid[static_cast<std::size_t>(row + wrap(x, e.nx))] = 1;
+        }
+      }
+    }
+  }
+}
+
+template <class Real>
+LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
+                               const spheres::SphereSet& spheres,
+                               std::vector<std::uint8_t>& solid) {
+  const lattice::Extent e = fluid.extent();
+  mark_solid_cells(e, spheres.position, spheres.radius, solid);
+  const double body_x = fluid.body_force().x;
+  const Real* field_x = fluid.has_force_field() ? fluid.force_field(0) : nullptr;
+  double velocity_sum = 0, momentum = 0, mass = 0;
+  long liquid = 0;
+#pragma omp parallel reduction(+ : velocity_sum, momentum, mass, liquid)
+  {
+    std::vector<double> rho(static_cast<std::size_t>(e.nx)), ux(rho.size()), uy(rho.size()),
+        uz(rho.size());
+#pragma omp for schedule(static)
+    for (long row = 0; row < static_cast<long>(e.ny) * e.nz; ++row) {
+      const int y = static_cast<int>(row % e.ny), z = static_cast<int>(row / e.ny);
+      // (sum c f + F_body / 2) / rho, without the per-cell field's half force
+      fluid.macroscopic_row_without_force_field(0, e.nx, y, z, rho.data(), ux.data(), uy.data(),
+                                                uz.data());
+      const long base = fluid.cell_index(0, y, z);
+      for (int x = 0; x < e.nx; ++x) {
+        momentum += rho[x] * ux[x] - 0.5 * body_x;
+        mass += rho[x];
+        if (solid[static_cast<std::size_t>(row * e.nx + x)]) continue;
+        const double field = field_x ? static_cast<double>(field_x[base + x]) : 0.0;
+        velocity_sum += ux[x] + 0.5 * field / rho[x];
+        ++liquid;
+      }
+    }
+  }
+  LiquidAverages out;
+  out.liquid_cells = liquid;
+  out.mean_velocity_x = liquid > 0 ? velocity_sum / static_cast<double>(liquid) : 0.0;
+  out.lattice_momentum_x = momentum;
+  out.mass = mass;
+  return out;
+}
+
+template LiquidAverages liquid_averages(const lattice::FluidLattice<float>&,
+                                        const spheres::SphereSet&, std::vector<std::uint8_t>&);
+template LiquidAverages liquid_averages(const lattice::FluidLattice<double>&,
+                                        const spheres::SphereSet&, std::vector<std::uint8_t>&);
+
+}  // namespace flocsim::observables

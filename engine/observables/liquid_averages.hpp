@@ -1,0 +1,38 @@
+#pragma once
+// Averages of the lattice liquid that the settling observables need (SPEC
+// section 4): the mean liquid velocity <u> over the liquid volume, i.e. over
+// the cells whose centre lies outside every sphere of hydrodynamic radius a
+// (the liquid the immersed boundary keeps inside a sphere moves with the
+// sphere and is not part of the suspending liquid), and the raw lattice
+// momentum for the momentum balance of liquid + spheres.
+#include <cstdint>
+#include <vector>
+
+#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/spheres/sphere_set.hpp"
+
+namespace flocsim::observables {
+
+struct LiquidAverages {
+  // Volume average over liquid cells of the physical velocity x component,
+  // (sum_i c_ix f_i + F/2) / rho with F the whole force on the cell (body force
+  // plus the per-cell force field).
+  double mean_velocity_x = 0;
+  long liquid_cells = 0;
+  // sum over every cell of sum_i c_ix f_i: the lattice momentum without any
+  // half-force shift (what the momentum balance conserves, sphere_dynamics.hpp).
+  double lattice_momentum_x = 0;
+  double mass = 0;  // sum of rho over every cell; not finite after a blow-up
+};
+
+// `solid` is scratch space (one byte per cell), reused between calls.
+template <class Real>
+LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
+                               const spheres::SphereSet& spheres, std::vector<std::uint8_t>& solid);
+
+// Marks (1) the cells whose centre (integer coordinates) lies within `radius`
+// of a sphere centre, periodic images included; the others 0.
+void mark_solid_cells(const lattice::Extent& extent, const std::vector<spheres::Vec3>& centres,
+                      double radius, std::vector<std::uint8_t>& solid);
+
+}  // namespace flocsim::observables

@@ -1,0 +1,27 @@
+#include "engine/observables/reference_correlations.hpp"
+
+#include <cmath>
+
+namespace flocsim::observables {
+
+double beetstra_drag(double phi, double reynolds) {
+  const double s = 1 - phi;
+  const double stokes = 10 * phi / (s * s) + s * s * (1 + 1.5 * std::sqrt(phi));
+  const double inertial = 0.413 * reynolds / (24 * s * s) *
+                          (1 / s + 3 * phi * s + 8.4 * std::pow(reynolds, -0.343)) /
+                          (1 + std::pow(10.0, 3 * phi) * std::pow(reynolds, -(1 + 4 * phi) / 2));
+  return stokes + inertial;
+}
+
+double richardson_zaki_exponent(double re) {
+  if (re < 0.2) return 4.65;
+  if (re < 1) return 4.35 * std::pow(re, -0.03);
+  if (re < 500) return 4.45 * std::pow(re, -0.1);
+  return 2.39;
+}
+
+double richardson_zaki_velocity_ratio(double phi, double reynolds_inf) {
+  return std::pow(1 - phi, richardson_zaki_exponent(reynolds_inf));
+}
+
+}  // namespace flocsim::observables

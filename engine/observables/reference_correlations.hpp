@@ -1,0 +1,22 @@
+#pragma once
+// Published correlations the settling observables are compared with
+// (VALIDATION.md, "Random and settling suspensions"). Written out once here so
+// that result.json, the postprocess tool and the tests use the same formulas.
+namespace flocsim::observables {
+
+// Beetstra, van der Hoef & Kuipers (2007), the paper's eq. 4, with its Stokes
+// part from van der Hoef et al. (2005). Normalisation: F = F_h / (6 pi mu a U)
+// with F_h the force per sphere without the mean pressure gradient
+// (= f V_p (1/phi - 1) for a body-force driven bed), U the superficial slip
+// velocity, Re = U 2a / nu. Static random arrays, Re <= 1000, phi <= 0.6,
+// about 10 % scatter.
+double beetstra_drag(double phi, double reynolds);
+
+// Richardson & Zaki (1954) hindered settling, U / U_inf = (1 - phi)^n with
+// n = 4.65 (Re < 0.2), 4.35 Re^-0.03 (0.2 <= Re < 1), 4.45 Re^-0.1
+// (1 <= Re < 500), 2.39 (Re >= 500), Re the single-sphere Re_inf. Settling
+// suspensions (not fixed beds), U the slip of the spheres through the liquid.
+double richardson_zaki_exponent(double reynolds_inf);
+double richardson_zaki_velocity_ratio(double phi, double reynolds_inf);
+
+}  // namespace flocsim::observables
