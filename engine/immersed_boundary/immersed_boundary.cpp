@@ -11,6 +11,10 @@
 #include <stdexcept>
 #include <string>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 #include "engine/immersed_boundary/kernel.hpp"
 #include "engine/immersed_boundary/sphere_markers.hpp"
 
@@ -62,6 +66,23 @@ std::vector<std::vector<std::vector<int>>> make_colours(
   return colours;
 }
 
+// x[k] = sqrt(x[k]) for k < n, several at a time where the instruction set
+// has it (std::sqrt does not vectorise while it may set errno). Square roots
+// are correctly rounded: the values of std::sqrt.
+void sqrt_in_place(double* x, int n) {
+  int k = 0;
+#if defined(__AVX512F__)
+  for (; k + 8 <= n; k += 8) _mm512_storeu_pd(x + k, _mm512_sqrt_pd(_mm512_loadu_pd(x + k)));
+#endif
+#if defined(__AVX__)
+  for (; k + 4 <= n; k += 4) _mm256_storeu_pd(x + k, _mm256_sqrt_pd(_mm256_loadu_pd(x + k)));
+#endif
+#if defined(__SSE2__)
+  for (; k + 2 <= n; k += 2) _mm_storeu_pd(x + k, _mm_sqrt_pd(_mm_loadu_pd(x + k)));
+#endif
+  for (; k < n; ++k) x[k] = std::sqrt(x[k]);
+}
+
 // Vectors of 4 and 16 numbers (GCC/Clang vector extensions: with AVX-512 a
 // 16-float vector is one register, 16 doubles two).
 template <class Real>
@@ -85,10 +106,10 @@ struct Simd {
 // four cells is one 16-number vector; a stencil row is three cells plus a
 // fourth with weight zero (the box rows have one spare cell for it), and each
 // operation is nine whole-row vector steps per marker.
-//   state:    (rho, v) per cell, v = u* + F / (2 rho): the velocity the collision sees;
-//   half_inv: 1 / (2 rho) per cell, four copies;
-//   force:    (0, F) per cell, F this sphere's force density.
-// w: the marker's 16 weight slots: x weights 0-2, y 3-5, z 6-8, slots 9-15 zero.
+//   state: (rho, v) per cell, v = u* + F / (2 rho): the velocity the collision sees;
+//   force: (0, F) per cell, F this sphere's force density.
+// w: the marker's 16 weight slots: x weights wx[a] in slots 0-2, the products
+// wy[b] wz[c] in slot 3 + b + 3 c, slots 12-15 zero.
 // base: the marker's stencil corner as an offset in numbers (4 per cell).
 template <class Real>
 struct Stencil {
@@ -102,48 +123,40 @@ struct Stencil {
         offset[b + 3 * c] = 4 * static_cast<std::size_t>(row_cells) * (b + box * c);
   }
   // x weight of each of the 16 numbers of a stencil row (zero for the fourth cell).
-  static V16 row_weights(V16 w) {
+  static V16 row_weights(const V16& w) {
     return __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 15, 15, 15, 15);
   }
-  // wy[b] wz[c] in slot b + 3 c.
-  static V16 yz_weights(V16 w) {
-    const V16 wy =
-        __builtin_shufflevector(w, w, 3, 4, 5, 3, 4, 5, 3, 4, 5, 15, 15, 15, 15, 15, 15, 15);
-    const V16 wz =
-        __builtin_shufflevector(w, w, 6, 6, 6, 7, 7, 7, 8, 8, 8, 15, 15, 15, 15, 15, 15, 15);
-    return wy * wz;
-  }
 
-  // Interpolated (rho, v) at the marker.
-  V4 interpolate(const Real* state, std::size_t base, V16 w) const {
-    const V16 wx = row_weights(w), wyz = yz_weights(w);
-    V16 acc = {};
+  // Interpolated (rho, v) at the marker: the x weights multiply the sum of
+  // the nine rows weighted by wy wz.
+  V4 interpolate(const Real* state, std::size_t base, const V16& w) const {
+    const Real* wyz = reinterpret_cast<const Real*>(&w) + 3;
+    const std::size_t o[9] = {offset[0], offset[1], offset[2], offset[3], offset[4],
+                              offset[5], offset[6], offset[7], offset[8]};
+    V16 acc[3] = {};  // three independent sums: a shorter dependency chain
 #pragma GCC unroll 9
     for (int l = 0; l < 9; ++l)
-      acc += (wx * wyz[l]) * Simd<Real>::template load<V16>(state + base + offset[l]);
-    const V4 a = __builtin_shufflevector(acc, acc, 0, 1, 2, 3);
-    const V4 b = __builtin_shufflevector(acc, acc, 4, 5, 6, 7);
-    const V4 c = __builtin_shufflevector(acc, acc, 8, 9, 10, 11);
+      acc[l % 3] += wyz[l] * Simd<Real>::template load<V16>(state + base + o[l]);
+    V16 sum = (acc[0] + acc[1] + acc[2]) * row_weights(w);
+    const V4 a = __builtin_shufflevector(sum, sum, 0, 1, 2, 3);
+    const V4 b = __builtin_shufflevector(sum, sum, 4, 5, 6, 7);
+    const V4 c = __builtin_shufflevector(sum, sum, 8, 9, 10, 11);
     return a + b + c;
   }
 
-  // Spreads (0, F_m dV) with the kernel: adds it to force and its
-  // velocity change, spread / (2 rho), to state.
-  // s points to the 4 numbers (0, F_m dV) (and 12 more, not used).
-  void spread(Real* force, Real* state, const Real* half_inv, std::size_t base, V16 w,
-              const Real* s) const {
+  // Adds (0, F_m dV) spread with the kernel to force; s points to those 4
+  // numbers (and 12 more, not used).
+  void spread(Real* force, std::size_t base, const V16& w, const Real* s) const {
     const V16 s4 = Simd<Real>::template load<V16>(s);
     const V16 ws = row_weights(w) *
                    __builtin_shufflevector(s4, s4, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3);
-    const V16 wyz = yz_weights(w);
+    const Real* wyz = reinterpret_cast<const Real*>(&w) + 3;
+    const std::size_t o[9] = {offset[0], offset[1], offset[2], offset[3], offset[4],
+                              offset[5], offset[6], offset[7], offset[8]};
+    Real* f = force + base;
 #pragma GCC unroll 9
-    for (int l = 0; l < 9; ++l) {
-      const std::size_t r = base + offset[l];
-      const V16 t = ws * wyz[l];
-      Simd<Real>::store(force + r, Simd<Real>::template load<V16>(force + r) + t);
-      Simd<Real>::store(state + r, Simd<Real>::template load<V16>(state + r) +
-                                       t * Simd<Real>::template load<V16>(half_inv + r));
-    }
+    for (int l = 0; l < 9; ++l)
+      Simd<Real>::store(f + o[l], Simd<Real>::template load<V16>(f + o[l]) + ws * wyz[l]);
   }
 };
 
@@ -158,21 +171,29 @@ struct ImmersedBoundary<Real>::Workspace {
   explicit Workspace(int box, int markers)
       : row_cells(box + 1),
         cells(static_cast<std::size_t>(row_cells) * box * box),
+        ustar(4 * cells, Real(0)),
         state(4 * cells, Real(0)),
-        half_inv(4 * cells, Real(1)),
+        half_inv(4 * cells, Real(0)),
         force(4 * cells, Real(0)),
         base(static_cast<std::size_t>(markers)),
         weights(static_cast<std::size_t>(markers)),
         target(static_cast<std::size_t>(markers)),
         marker_force(static_cast<std::size_t>(markers)),
-        increment(static_cast<std::size_t>(markers) + 3) {}  // spread() reads 16 numbers
+        increment(static_cast<std::size_t>(markers) + 3),  // spread() reads 16 numbers
+        nearest(3 * static_cast<std::size_t>(markers)),
+        root(3 * static_cast<std::size_t>(markers)) {}
   int row_cells;  // box + 1: room for the fourth cell of a stencil row at the far end
   std::size_t cells;
-  std::vector<Real> state, half_inv, force;         // 4 numbers per cell
+  // u* = (rho, u*), state = (rho, v) (see Stencil), half_inv: 1 / (2 rho) four
+  // times, force = (0, F): 4 numbers per cell.
+  std::vector<Real> ustar, state, half_inv, force;  // 4 numbers per cell
   std::vector<int> global[3];                       // wrapped lattice coordinate of each box row
   std::vector<std::size_t> base;                    // stencil corner of each marker (numbers)
   std::vector<V16> weights;                         // kernel weights of each marker
   std::vector<V4> target, marker_force, increment;  // (0, vector) per marker
+  std::vector<double> nearest, root;                // per marker and direction: kernel centre, q
+  std::vector<const Real*> lines;                   // cache lines of the next sphere
+  int fetched = -1;                                 // the sphere whose lines were fetched
 };
 
 template <class Real>
@@ -193,6 +214,23 @@ ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings) : se
                                 std::to_string(settings.input_radius) + ": must be <= 10000 dx");
   const int n = marker_count(settings.input_radius, settings.marker_spacing);
   directions_ = fibonacci_sphere(n);
+  // Markers ordered in bands of z (about one spacing high), by azimuth within
+  // a band: consecutive markers are neighbours, so their stencils share cells
+  // (cache reuse in the sweeps). Only the order of sums depends on it.
+  {
+    const int bands = std::max(
+        1, static_cast<int>(std::ceil(2.0 * settings.input_radius / settings.marker_spacing)));
+    auto key = [&](const Vec3& u) {
+      const int band = std::min(bands - 1, static_cast<int>((u[2] + 1.0) / 2.0 * bands));
+      double phi = std::atan2(u[1], u[0]);
+      if (band % 2) phi = -phi;
+      return std::pair<int, double>(band, phi);
+    };
+    std::sort(directions_.begin(), directions_.end(),
+              [&](const Vec3& a, const Vec3& b) { return key(a) < key(b); });
+  }
+  for (const Vec3& u : directions_)
+    for (int d = 0; d < 3; ++d) offsets_.push_back(settings.input_radius * u[d]);
   marker_volume_ = immersed_boundary::marker_volume(settings.input_radius, n);
   box_ = static_cast<int>(std::ceil(2.0 * settings.input_radius)) + 5;
 }
@@ -240,7 +278,7 @@ template <class Real>
 void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
                                    const spheres::SphereSet& spheres) {
   using V4 = typename Simd<Real>::V4;
-  using V16 = typename Simd<Real>::V16;
+  using V4d = typename Simd<double>::V4;
   const lattice::Extent e = fluid.extent();
   const double ag = settings_.input_radius;
   const int length[3] = {e.nx, e.ny, e.nz};
@@ -364,7 +402,33 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   const Real dVr = static_cast<Real>(dV);
   const V4 vector_part = {0, 1, 1, 1};
 
-  auto process = [&](Workspace& ws, int s) {
+  // Calls fetch(address) for each cache line of ustar_ that sphere s reads
+  // and of the force field that it adds to.
+  auto sphere_lines = [&](int s, auto&& fetch) {
+    constexpr int step = 64 / static_cast<int>(sizeof(Real));
+    const auto& lo = origins_[static_cast<std::size_t>(s)];
+    const std::int16_t* rows = &rows_[2 * static_cast<std::size_t>(s) * B * B];
+    for (int k = 0; k < B; ++k)
+      for (int j = 0; j < B; ++j) {
+        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+        if (i0 > i1) continue;
+        const long grow = fluid.cell_index(0, wrap(lo[1] + j, e.ny), wrap(lo[2] + k, e.nz));
+        for (int i = i0; i <= i1;) {
+          const int gx = wrap(lo[0] + i, e.nx);
+          const int count = std::min(i1 - i + 1, e.nx - gx);
+          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
+          for (int q = 0; q < 4 * count; q += step) fetch(from + q);
+          fetch(from + 4 * count - 1);
+          for (int d = 0; d < 3; ++d) {
+            for (int q = 0; q < count; q += step) fetch(field[d] + grow + gx + q);
+            fetch(field[d] + grow + gx + count - 1);
+          }
+          i += count;
+        }
+      }
+  };
+
+  auto process = [&](Workspace& ws, int s, int next) {
     const Vec3 centre = spheres.position[static_cast<std::size_t>(s)];
     const Vec3 up = spheres.velocity[static_cast<std::size_t>(s)];
     const Vec3 omega = spheres.angular_velocity[static_cast<std::size_t>(s)];
@@ -376,50 +440,54 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       for (int i = 0; i < B; ++i)
         ws.global[d][static_cast<std::size_t>(i)] = wrap(lo[d] + i, length[d]);
     }
-    // Fetch the sphere's u* rows (and the force field lines it will add to)
-    // while the stencils are computed.
-    for (int k = 0; k < B; ++k)
-      for (int j = 0; j < B; ++j) {
-        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-        if (i0 > i1) continue;
-        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
-                                           ws.global[2][static_cast<std::size_t>(k)]);
-        for (int i = i0; i <= i1;) {
-          const int gx = ws.global[0][static_cast<std::size_t>(i)];
-          const int count = std::min(i1 - i + 1, length[0] - gx);
-          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
-          for (int q = 0; q < 4 * count; q += 64 / static_cast<int>(sizeof(Real)))
-            __builtin_prefetch(from + q);
-          __builtin_prefetch(from + 4 * count - 1);
-          for (int d = 0; d < 3; ++d) {
-            for (int q = 0; q < count; q += 64 / static_cast<int>(sizeof(Real)))
-              __builtin_prefetch(field[d] + grow + gx + q, 1);
-            __builtin_prefetch(field[d] + grow + gx + count - 1, 1);
-          }
-          i += count;
+    // The lines of this sphere were fetched during the previous sphere's
+    // sweeps, or are fetched now while the stencils are computed; the next
+    // sphere's are fetched during this one's sweeps.
+    if (ws.fetched != s) sphere_lines(s, [](const Real* p) { __builtin_prefetch(p); });
+    ws.lines.clear();
+    if (next >= 0) sphere_lines(next, [&](const Real* p) { ws.lines.push_back(p); });
+    ws.fetched = next;
+    std::size_t line = 0;
+    const std::size_t lines_per_marker =
+        ws.lines.size() / static_cast<std::size_t>(markers * iterations) + 1;
+    // Stencils (Roma weights, one square root per direction) and targets.
+    {
+      const double* r = offsets_.data();
+      double* near = ws.nearest.data();
+      double* q = ws.root.data();
+      const double c0 = centre[0], c1 = centre[1], c2 = centre[2];
+#pragma omp simd
+      for (int m = 0; m < markers; ++m) {
+        const double X[3] = {c0 + r[3 * m], c1 + r[3 * m + 1], c2 + r[3 * m + 2]};
+        for (int d = 0; d < 3; ++d) {
+          near[3 * m + d] = std::nearbyint(X[d]);
+          const double dd = X[d] - near[3 * m + d];
+          q[3 * m + d] = 1.0 - 3.0 * dd * dd;
         }
       }
-    // Stencils (Roma weights, one square root per direction) and targets.
+      sqrt_in_place(q, 3 * markers);
+    }
+    const double u0 = up[0], u1 = up[1], u2 = up[2];
+    const double o0 = omega[0], o1 = omega[1], o2 = omega[2];
     for (int m = 0; m < markers; ++m) {
-      const Vec3 r = ag * directions_[static_cast<std::size_t>(m)];
+      const std::size_t k = static_cast<std::size_t>(m);
+      const double* r = &offsets_[3 * k];
       int first[3];
       double w[3][3];
       for (int d = 0; d < 3; ++d) {
-        const double X = centre[d] + r[d];
-        const double nearest = std::nearbyint(X);
-        first[d] = static_cast<int>(nearest) - 1 - lo[d];
-        roma_weights(X - nearest, w[d]);
+        const double near = ws.nearest[3 * k + d];
+        first[d] = static_cast<int>(near) - 1 - lo[d];
+        roma_weights_from_root(centre[d] + r[d] - near, ws.root[3 * k + d], w[d]);
       }
-      ws.base[static_cast<std::size_t>(m)] =
-          4 * static_cast<std::size_t>(first[0] + R * (first[1] + B * first[2]));
-      V16 wm = {};
-      for (int d = 0; d < 3; ++d)
-        for (int a = 0; a < 3; ++a) wm[3 * d + a] = static_cast<Real>(w[d][a]);
-      ws.weights[static_cast<std::size_t>(m)] = wm;
-      const Vec3 t = up + omega.cross(r);
-      ws.target[static_cast<std::size_t>(m)] =
-          V4{0, static_cast<Real>(t[0]), static_cast<Real>(t[1]), static_cast<Real>(t[2])};
-      ws.marker_force[static_cast<std::size_t>(m)] = V4{};
+      Real* wm = reinterpret_cast<Real*>(&ws.weights[k]);  // slots 12-15 stay zero
+      for (int a = 0; a < 3; ++a) wm[a] = static_cast<Real>(w[0][a]);
+      for (int c = 0; c < 3; ++c)
+        for (int b = 0; b < 3; ++b) wm[3 + b + 3 * c] = static_cast<Real>(w[1][b] * w[2][c]);
+      ws.base[k] = 4 * static_cast<std::size_t>(first[0] + R * (first[1] + B * first[2]));
+      ws.target[k] = V4{0, static_cast<Real>(u0 + o1 * r[2] - o2 * r[1]),
+                        static_cast<Real>(u1 + o2 * r[0] - o0 * r[2]),
+                        static_cast<Real>(u2 + o0 * r[1] - o1 * r[0])};
+      ws.marker_force[k] = V4{};
     }
     // u* and 1/(2 rho) of the sphere's cells, from the pass.
     for (int k = 0; k < B; ++k)
@@ -433,8 +501,9 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
           const int gx = ws.global[0][static_cast<std::size_t>(i)];
           const int count = std::min(i1 - i + 1, length[0] - gx);
           const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
-          Real* to = &ws.state[4 * (row + i)];
-          for (int q = 0; q < 4 * count; ++q) to[q] = from[q];
+          Real* to = &ws.ustar[4 * (row + i)];
+          Real* v = &ws.state[4 * (row + i)];
+          for (int q = 0; q < 4 * count; ++q) to[q] = v[q] = from[q];
           i += count;
         }
         const Real* __restrict st = &ws.state[4 * row];
@@ -449,6 +518,8 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     Real* const state = ws.state.data();
     for (int it = 0; it < iterations; ++it) {
       for (int m = 0; m < markers; ++m) {
+        for (std::size_t q = 0; q < lines_per_marker && line < ws.lines.size(); ++q)
+          __builtin_prefetch(ws.lines[line++]);
         const std::size_t k = static_cast<std::size_t>(m);
         const V4 u = stencil.interpolate(state, ws.base[k], ws.weights[k]);
         const V4 dF = (Real(2) * u[0]) * (ws.target[k] - u) * vector_part;
@@ -457,8 +528,21 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       }
       for (int m = 0; m < markers; ++m) {
         const std::size_t k = static_cast<std::size_t>(m);
-        stencil.spread(ws.force.data(), state, ws.half_inv.data(), ws.base[k], ws.weights[k],
+        stencil.spread(ws.force.data(), ws.base[k], ws.weights[k],
                        reinterpret_cast<const Real*>(&ws.increment[k]));
+      }
+      // v = u* + F / (2 rho) on the sphere's cells.
+      for (int row = 0; row < B * B; ++row) {
+        const int i0 = rows[2 * row], i1 = rows[2 * row + 1];
+        if (i0 > i1) continue;
+        const std::size_t a = 4 * (static_cast<std::size_t>(R) * row + i0);
+        const std::size_t b = 4 * (static_cast<std::size_t>(R) * row + i1 + 1);
+        const Real* __restrict us = ws.ustar.data();
+        const Real* __restrict h = ws.half_inv.data();
+        const Real* __restrict f = ws.force.data();
+        Real* __restrict v = ws.state.data();
+#pragma omp simd
+        for (std::size_t q = a; q < b; ++q) v[q] = us[q] + h[q] * f[q];
       }
     }
     if (measure) {
@@ -485,7 +569,8 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     }
     force_[static_cast<std::size_t>(s)] = F;
     torque_[static_cast<std::size_t>(s)] = T;
-    // Momentum of the liquid inside, rho v = rho u* + F/2: the collision's.
+    // Momentum of the liquid inside, rho v = rho u* + F/2 (the collision's),
+    // weighted by w = min(1, a_g + 1/2 - |r|).
     double P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     const double reach = ag + 0.5;
     for (int k = 0; k < B; ++k) {
@@ -498,24 +583,24 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
         const double half = std::sqrt(left);
         const int i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
         const int i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
+        if (i0 > i1) continue;
+        // Per cell j = w rho v (lane 0 unused); over the row sum j and rx j.
+        V4d sum = {}, moment = {};
         const Real* st = &ws.state[4 * static_cast<std::size_t>(R) * (j + B * k)];
-        double px = 0, py = 0, pz = 0, lx = 0, ly = 0, lz = 0;
-#pragma omp simd reduction(+ : px, py, pz, lx, ly, lz)
         for (int i = i0; i <= i1; ++i) {
           const double rx = lo[0] + i - centre[0];
-          const double dist = std::sqrt(rx * rx + ry * ry + rz * rz);
-          const double w = std::clamp(reach - dist, 0.0, 1.0);
-          const double rho = st[4 * i];
-          const double jx = rho * st[4 * i + 1], jy = rho * st[4 * i + 2], jz = rho * st[4 * i + 3];
-          px += w * jx;
-          py += w * jy;
-          pz += w * jz;
-          lx += w * (ry * jz - rz * jy);
-          ly += w * (rz * jx - rx * jz);
-          lz += w * (rx * jy - ry * jx);
+          const double w = std::min(1.0, reach - std::sqrt(rx * rx + ry * ry + rz * rz));
+          if (w <= 0) continue;
+          const V4d c = __builtin_convertvector(Simd<Real>::template load<V4>(st + 4 * i), V4d);
+          const V4d jc = (w * c[0]) * c;
+          sum += jc;
+          moment += rx * jc;
         }
-        P[0] += px, P[1] += py, P[2] += pz;
-        L[0] += lx, L[1] += ly, L[2] += lz;
+        // L = sum r x j with ry, rz fixed on the row.
+        P[0] += sum[1], P[1] += sum[2], P[2] += sum[3];
+        L[0] += ry * sum[3] - rz * sum[2];
+        L[1] += rz * sum[1] - moment[3];
+        L[2] += moment[2] - ry * sum[1];
       }
     }
     momentum[static_cast<std::size_t>(s)] = Vec3(P[0], P[1], P[2]);
@@ -547,13 +632,31 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       }
   };
 
+  // Blocks of one colour in parallel, handed out one at a time; a thread
+  // takes its next block before working on the current one, so that it knows
+  // the next sphere and can fetch its lines early.
+  std::vector<std::atomic<std::size_t>> taken(colours.size());
 #pragma omp parallel
   {
     Workspace& ws = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
-    for (const auto& blocks : colours) {
-#pragma omp for schedule(dynamic, 1)
-      for (std::size_t b = 0; b < blocks.size(); ++b)
-        for (int s : blocks[b]) process(ws, s);
+    ws.fetched = -1;
+    for (std::size_t c = 0; c < colours.size(); ++c) {
+      const auto& blocks = colours[c];
+      std::size_t block = taken[c]++;
+      while (block < blocks.size()) {
+        const std::size_t following = taken[c]++;
+        const auto& members = blocks[block];
+        for (std::size_t i = 0; i < members.size(); ++i) {
+          int next = -1;
+          if (i + 1 < members.size())
+            next = members[i + 1];
+          else if (following < blocks.size())
+            next = blocks[following].front();
+          process(ws, members[i], next);
+        }
+        block = following;
+      }
+#pragma omp barrier
     }
   }
   written_ = origins_;

@@ -115,6 +115,7 @@ class ImmersedBoundary {
 
   ImmersedBoundarySettings settings_;
   std::vector<Vec3> directions_;  // unit vectors of the markers
+  std::vector<double> offsets_;   // a_g times the unit vectors, x y z per marker
   double marker_volume_ = 0;
   int box_ = 0;  // edge of the cell box around a sphere
 

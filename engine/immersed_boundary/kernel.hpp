@@ -37,12 +37,18 @@ struct KernelWeights {
 // With d = x - round(x) in [-1/2, 1/2] the three arguments are d + 1, d and
 // d - 1, and all three weights share one square root q = sqrt(1 - 3 d^2):
 // phi(d) = (1 + q) / 3, phi(d + 1) = (2 - 3 d - q) / 6, phi(d - 1) = (2 + 3 d - q) / 6
-// (the same values as roma_kernel, one sqrt instead of three; they sum to 1).
+// (the values of roma_kernel to round-off, one sqrt instead of three). The
+// weights sum to 1 and have zero first moment for any q, so an error in q
+// changes only the kernel's shape, never the conservation of force or torque.
+inline void roma_weights_from_root(double d, double q, double (&w)[3]) {
+  constexpr double sixth = 1.0 / 6.0;
+  w[0] = std::max(0.0, 2.0 - 3.0 * d - q) * sixth;  // max: no -1e-17 at |d| = 1/2
+  w[1] = (2.0 + 2.0 * q) * sixth;
+  w[2] = std::max(0.0, 2.0 + 3.0 * d - q) * sixth;
+}
+
 inline void roma_weights(double d, double (&w)[3]) {
-  const double q = std::sqrt(1.0 - 3.0 * d * d);
-  w[0] = std::max(0.0, 2.0 - 3.0 * d - q) / 6.0;  // max: no -1e-17 at |d| = 1/2
-  w[1] = (1.0 + q) / 3.0;
-  w[2] = std::max(0.0, 2.0 + 3.0 * d - q) / 6.0;
+  roma_weights_from_root(d, std::sqrt(1.0 - 3.0 * d * d), w);
 }
 
 inline KernelWeights kernel_weights(double x) {
