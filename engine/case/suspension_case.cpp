@@ -9,6 +9,7 @@
 #include "engine/case/case_support.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/output/hdf5_file.hpp"
 
 namespace flocsim::cases {
 
@@ -31,6 +32,51 @@ Preset preset(const std::string& fidelity) {
   return {6, 48, 30, 150, 100, 300};  // paper
 }
 
+// Sphere centres of a snapshot written by a run (spheres/step_N.h5), checked
+// against this case: same radius, inside the box, no overlap.
+std::vector<double> snapshot_positions(const std::string& file, double a,
+                                       const lattice::Extent& box) {
+  const std::string field = "positions_from = \"" + file + "\"";
+  std::vector<double> x;
+  double radius = 0;
+  try {
+    output::Hdf5File f(file, output::Hdf5File::Mode::read);
+    x = f.read<double>("/position");
+    radius = f.attribute_double("/", "radius");
+  } catch (const std::exception& e) {
+    throw InputError(field +
+                     ": must be a sphere snapshot (spheres/step_N.h5 of a run): " + e.what());
+  }
+  if (x.empty() || x.size() % 3 != 0)
+    throw InputError(field + ": /position must hold N x 3 centres, holds " +
+                     std::to_string(x.size()) + " numbers");
+  if (std::abs(radius - a) > 1e-9)
+    throw InputError(field + ": its spheres have radius " + format_value(radius) +
+                     ", the case has numerics.a_over_dx = " + format_value(a));
+  const double L[3] = {static_cast<double>(box.nx), static_cast<double>(box.ny),
+                       static_cast<double>(box.nz)};
+  const std::size_t n = x.size() / 3;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      if (!(x[3 * i + d] >= 0 && x[3 * i + d] < L[d]))
+        throw InputError(field + ": sphere " + std::to_string(i) + " lies outside the " +
+                         std::to_string(box.nx) + " x " + std::to_string(box.ny) + " x " +
+                         std::to_string(box.nz) + " box of this case (L_over_a, L_over_W)");
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      double r2 = 0;
+      for (int d = 0; d < 3; ++d) {
+        double dx = x[3 * i + d] - x[3 * j + d];
+        dx -= L[d] * std::round(dx / L[d]);
+        r2 += dx * dx;
+      }
+      if (r2 < 4 * a * a * (1 - 1e-9))
+        throw InputError(field + ": spheres " + std::to_string(i) + " and " + std::to_string(j) +
+                         " overlap (centre distance " + format_value(std::sqrt(r2)) + " < 2a)");
+    }
+  return x;
+}
+
 }  // namespace
 
 double schiller_naumann_drag_coefficient(double reynolds) {
@@ -48,7 +94,16 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 
   const bool single = c.scene == "single-sphere";
-  if (!single)
+  if (root.has("positions_from")) {
+    if (c.scene != "fixed-array")
+      throw InputError("positions_from: only for scene \"fixed-array\" (scene = \"" + c.scene +
+                       "\")");
+    if (root.has("phi"))
+      throw InputError(
+          "phi and positions_from: give one; with positions_from the snapshot sets N and phi");
+    c.positions_from = root.text("positions_from");
+  }
+  if (!single && c.positions_from.empty())
     c.phi = root.number("phi",
                         {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
   c.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
@@ -166,6 +221,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
   c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));
+  if (!c.positions_from.empty()) {
+    c.initial_positions = snapshot_positions(c.positions_from, a, c.box);
+    c.sphere_count = static_cast<int>(c.initial_positions.size() / 3);
+    c.phi = c.sphere_count * sphere_volume / volume;
+  }
   if (c.sphere_count < 1)
     throw InputError("phi = " + format_value(c.phi) +
                      ": gives N = 0 spheres in this box; raise phi or L_over_a");
@@ -201,7 +261,10 @@ nlohmann::json SuspensionCase::to_json() const {
   j["fidelity"] = fidelity;
   j["precision"] = single_precision ? "float" : "double";
   j["seed"] = seed;
-  if (scene != "single-sphere") j["phi"] = phi;
+  if (!positions_from.empty())
+    j["positions_from"] = positions_from;
+  else if (scene != "single-sphere")
+    j["phi"] = phi;
   j["Re_inf"] = reynolds_inf;
   j["density_ratio"] = density_ratio;
   j["du_over_Uinf"] = du_over_uinf;

@@ -32,6 +32,11 @@ struct SuspensionCase {
   bool single_precision = false;
   std::uint64_t seed = 1;
 
+  // fixed-array only: hold the spheres of this run's snapshot
+  // (spheres/step_N.h5) still instead of placing them at random (paper Fig. 1b)
+  std::string positions_from;
+  std::vector<double> initial_positions;  // its centres, x y z per sphere
+
   // ---- dimensionless inputs (paper Table 1) --------------------------------
   double phi = 0.20;                            // requested solids fraction
   double reynolds_inf = 12;                     // Re_inf = U_inf 2a / nu

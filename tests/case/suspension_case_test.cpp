@@ -6,8 +6,14 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
 
 #include "engine/input/input_reader.hpp"
+#include "engine/output/field_snapshots.hpp"
+#include "engine/output/sphere_snapshots.hpp"
 
 namespace flocsim::cases {
 namespace {
@@ -156,6 +162,51 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
   // a granular gas has no liquid and needs no calibration
   EXPECT_NO_THROW(parse_suspension_case(
       {{"scene", "granular"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 5}}}}));
+}
+
+// A fixed array from a snapshot: N and phi come from the file, which must hold
+// spheres of the case's radius, inside its box, without overlap.
+TEST(SuspensionCase, FixedArrayFromASnapshot) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("flocsim_snapshot_case_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  spheres::SphereSet s;
+  s.radius = 4;
+  s.resize(3);
+  s.position = {{10, 10, 10}, {20, 10, 10}, {30, 20, 5}};
+  output::write_sphere_snapshot(dir, 7, 0.1, s, {0, 1, 2});
+  const std::string file = output::snapshot_file(dir, 7).string();
+  json d = {{"scene", "fixed-array"},
+            {"fidelity", "draft"},
+            {"positions_from", file},
+            {"numerics", {{"a_over_dx", 4}}}};
+  const SuspensionCase c = parse_suspension_case(d);  // draft: 64 x 32 x 32 cells
+  EXPECT_EQ(c.sphere_count, 3);
+  EXPECT_NEAR(c.phi_realised, 3 * (4.0 / 3.0) * M_PI * 64 / (64.0 * 32 * 32), 1e-15);
+  EXPECT_EQ(c.initial_positions[6], 30.0);
+  EXPECT_EQ(c.to_json()["positions_from"], file);
+
+  json wrong = d;
+  wrong["numerics"]["a_over_dx"] = 6;  // radius differs; the box grows to 96 x 48 x 48
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("positions_from"), HasSubstr("radius 4")));
+  wrong = d;
+  wrong["phi"] = 0.1;
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("phi and positions_from")));
+  wrong = d;
+  wrong["scene"] = "suspension";
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("positions_from"), HasSubstr("fixed-array")));
+  s.position[1] = {17, 10, 10};  // 7 < 2a apart
+  output::write_sphere_snapshot(dir, 8, 0.1, s, {0, 1, 2});
+  wrong = d;
+  wrong["positions_from"] = output::snapshot_file(dir, 8).string();
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("spheres 0 and 1 overlap")));
+  s.position[1] = {70, 10, 10};  // outside the 64-cell box
+  output::write_sphere_snapshot(dir, 9, 0.1, s, {0, 1, 2});
+  wrong["positions_from"] = output::snapshot_file(dir, 9).string();
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("sphere 1 lies outside")));
+  wrong["positions_from"] = (dir / "missing.h5").string();
+  EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("must be a sphere snapshot")));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
