@@ -72,7 +72,8 @@ std::vector<std::vector<std::vector<int>>> make_colours(
 void sqrt_in_place(double* x, int n) {
   int k = 0;
 #if defined(__AVX512F__)
-  for (; k + 8 <= n; k += 8) _mm512_storeu_pd(x + k, _mm512_sqrt_pd(_mm512_loadu_pd(x + k)));
+  for (; k + 8 <= n; k += 8)
+    _mm512_storeu_pd(x + k, _mm512_maskz_sqrt_pd(0xFF, _mm512_loadu_pd(x + k)));
 #endif
 #if defined(__AVX__)
   for (; k + 4 <= n; k += 4) _mm256_storeu_pd(x + k, _mm256_sqrt_pd(_mm256_loadu_pd(x + k)));
@@ -214,21 +215,6 @@ ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings) : se
                                 std::to_string(settings.input_radius) + ": must be <= 10000 dx");
   const int n = marker_count(settings.input_radius, settings.marker_spacing);
   directions_ = fibonacci_sphere(n);
-  // Markers ordered in bands of z (about one spacing high), by azimuth within
-  // a band: consecutive markers are neighbours, so their stencils share cells
-  // (cache reuse in the sweeps). Only the order of sums depends on it.
-  {
-    const int bands = std::max(
-        1, static_cast<int>(std::ceil(2.0 * settings.input_radius / settings.marker_spacing)));
-    auto key = [&](const Vec3& u) {
-      const int band = std::min(bands - 1, static_cast<int>((u[2] + 1.0) / 2.0 * bands));
-      double phi = std::atan2(u[1], u[0]);
-      if (band % 2) phi = -phi;
-      return std::pair<int, double>(band, phi);
-    };
-    std::sort(directions_.begin(), directions_.end(),
-              [&](const Vec3& a, const Vec3& b) { return key(a) < key(b); });
-  }
   for (const Vec3& u : directions_)
     for (int d = 0; d < 3; ++d) offsets_.push_back(settings.input_radius * u[d]);
   marker_volume_ = immersed_boundary::marker_volume(settings.input_radius, n);
@@ -353,11 +339,10 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       }
     }
   }
-  // One pass over the lattice rows in memory order: zero the force field on
+  // The pass over the lattice rows, in memory order: zero the force field on
   // the chunks of the last apply() and compute u* on the chunks needed now
   // (runs of chunks at once), so that the streams are read nearly in order.
-#pragma omp parallel for schedule(static)
-  for (std::size_t r = 0; r < lattice_rows; ++r) {
+  auto pass_row = [&](std::size_t r) {
     const int y = static_cast<int>(r % e.ny), z = static_cast<int>(r / e.ny);
     const long row = fluid.cell_index(0, y, z);
     if (zero_in_pass) {
@@ -382,12 +367,31 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       fluid.macroscopic_row_without_force_field(x0, x1 - x0, y, z, out + 4 * x0);
       c = c1;
     }
+  };
+  // The pass and the spheres go together in slabs of z planes: after the
+  // pass over a slab, the spheres whose cells lie in the planes done so far
+  // (and not across the periodic z edge) are processed, while u* and the
+  // force-field lines of those planes are still in the last-level cache.
+  // Spheres across the z edge wait for the last slab.
+  const int planes = std::max(B, (e.nz + 7) / 8);
+  const int slabs = (e.nz + planes - 1) / planes;
+  std::vector<std::vector<int>> slab_spheres(static_cast<std::size_t>(slabs));
+  for (std::size_t s = 0; s < n; ++s) {
+    const int bottom = origins_[s][2], top = bottom + B - 1;
+    const int slab = bottom < 0 || top >= e.nz ? slabs - 1 : top / planes;
+    slab_spheres[static_cast<std::size_t>(slab)].push_back(static_cast<int>(s));
   }
-  if (!zero_in_pass) held_.assign(lattice_rows * words, 0);
-  need_.swap(held_);  // need_ is all zero again
-  written_.clear();
+  std::vector<std::vector<std::vector<std::vector<int>>>> slab_colours;
+  for (const auto& members : slab_spheres) {
+    std::vector<std::array<int, 3>> o;
+    for (int s : members) o.push_back(origins_[static_cast<std::size_t>(s)]);
+    auto colours = make_colours(o, B, e);
+    for (auto& blocks : colours)
+      for (auto& block : blocks)
+        for (int& k : block) k = members[static_cast<std::size_t>(k)];
+    slab_colours.push_back(std::move(colours));
+  }
 
-  const auto colours = make_colours(origins_, B, e);
   const int threads = omp_get_max_threads();
   if (static_cast<int>(workspaces_.size()) < threads)
     workspaces_.resize(static_cast<std::size_t>(threads));
@@ -635,30 +639,41 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   // Blocks of one colour in parallel, handed out one at a time; a thread
   // takes its next block before working on the current one, so that it knows
   // the next sphere and can fetch its lines early.
-  std::vector<std::atomic<std::size_t>> taken(colours.size());
+  std::size_t colour_count = 0;
+  for (const auto& colours : slab_colours) colour_count += colours.size();
+  std::vector<std::atomic<std::size_t>> taken(colour_count);
 #pragma omp parallel
   {
     Workspace& ws = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
     ws.fetched = -1;
-    for (std::size_t c = 0; c < colours.size(); ++c) {
-      const auto& blocks = colours[c];
-      std::size_t block = taken[c]++;
-      while (block < blocks.size()) {
-        const std::size_t following = taken[c]++;
-        const auto& members = blocks[block];
-        for (std::size_t i = 0; i < members.size(); ++i) {
-          int next = -1;
-          if (i + 1 < members.size())
-            next = members[i + 1];
-          else if (following < blocks.size())
-            next = blocks[following].front();
-          process(ws, members[i], next);
+    std::size_t counter = 0;
+    for (int slab = 0; slab < slabs; ++slab) {
+      const std::size_t r0 = static_cast<std::size_t>(slab) * planes * e.ny;
+      const std::size_t r1 = std::min(lattice_rows, r0 + static_cast<std::size_t>(planes) * e.ny);
+#pragma omp for schedule(static)
+      for (std::size_t r = r0; r < r1; ++r) pass_row(r);
+      for (const auto& blocks : slab_colours[static_cast<std::size_t>(slab)]) {
+        std::atomic<std::size_t>& next_block = taken[counter++];
+        std::size_t block = next_block++;
+        while (block < blocks.size()) {
+          const std::size_t following = next_block++;
+          const auto& members = blocks[block];
+          for (std::size_t i = 0; i < members.size(); ++i) {
+            int next = -1;
+            if (i + 1 < members.size())
+              next = members[i + 1];
+            else if (following < blocks.size())
+              next = blocks[following].front();
+            process(ws, members[i], next);
+          }
+          block = following;
         }
-        block = following;
-      }
 #pragma omp barrier
+      }
     }
   }
+  if (!zero_in_pass) held_.assign(lattice_rows * words, 0);
+  need_.swap(held_);  // need_ is all zero again
   written_ = origins_;
   written_rows_.swap(rows_);
   internal_momentum_change_.assign(n, Vec3::Zero());
