@@ -97,7 +97,7 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
     }
     // The interleaved reader (the immersed boundary's), on pieces that start
     // or end at the periodic edges and inside.
-    for (const auto [x0, count] :
+    for (const auto& [x0, count] :
          {std::pair{0, 9}, std::pair{3, 6}, std::pair{0, 1}, std::pair{8, 1}, std::pair{2, 4}}) {
       double rho_u[36];
       fluid.macroscopic_row_without_force_field(x0, count, 6, 5, rho_u);
