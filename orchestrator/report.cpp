@@ -201,6 +201,21 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
     }
     if (any) cols.push_back(c);
   }
+  if (!o.columns.empty()) {
+    std::vector<std::string> chosen;
+    for (const std::string& c : o.columns) {
+      if (std::find(t.columns.begin(), t.columns.end(), c) == t.columns.end()) {
+        std::string all;
+        for (const auto& a : t.columns) all += (all.empty() ? "" : ", ") + a;
+        throw InputError("--columns " + c + ": no such column (columns: " + all + ")");
+      }
+      chosen.push_back(c);
+      const std::string err = c + "_err";
+      if (std::find(t.columns.begin(), t.columns.end(), err) != t.columns.end())
+        chosen.push_back(err);
+    }
+    cols = chosen;
+  }
   if (o.format == "json") {
     ordered_json arr = ordered_json::array();
     for (std::size_t i : keep) {

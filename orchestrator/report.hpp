@@ -23,6 +23,9 @@ struct QueryOptions {
   std::optional<std::string> sweep;  // restrict to one sweep
   std::vector<Filter> where;
   std::string format = "table";  // table | csv | json
+  // Only these columns (an observable brings its error along), in this order;
+  // empty: every column some row fills.
+  std::vector<std::string> columns;
 };
 
 // Runs the query and writes it to `out`; returns the number of rows written.

@@ -18,7 +18,7 @@ const bool registered = register_command(
      [](CLI::App& cmd) {
        struct Options {
          std::string db_path, sweep, format = "table";
-         std::vector<std::string> where;
+         std::vector<std::string> where, columns;
        };
        auto o = std::make_shared<Options>();
        cmd.add_option("--db", o->db_path, "Results database")->required();
@@ -27,6 +27,10 @@ const bool registered = register_command(
                       "Filter FIELD OP VALUE (OP: = != < <= > >=); FIELD is a column (status, an "
                       "axis, an observable, NAME_err, wall_s) or a dotted case path; repeat to AND")
            ->take_all();
+       cmd.add_option("--columns,-c", o->columns,
+                      "Only these columns, in this order (comma-separated or repeated), e.g. "
+                      "phi,du_over_Uinf,U_over_Uinf,F")
+           ->delimiter(',');
        cmd.add_option("--format,-f", o->format, "Output format")
            ->check(CLI::IsMember({"table", "csv", "json"}));
        return CommandHandler([o]() -> int {
@@ -34,6 +38,7 @@ const bool registered = register_command(
            orc::QueryOptions q;
            if (!o->sweep.empty()) q.sweep = o->sweep;
            q.format = o->format;
+           q.columns = o->columns;
            for (const std::string& w : o->where) q.where.push_back(orc::parse_filter(w));
            db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
            orc::write_query(db, q, std::cout);

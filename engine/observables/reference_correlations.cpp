@@ -13,6 +13,17 @@ double beetstra_drag(double phi, double reynolds) {
   return stokes + inertial;
 }
 
+double beetstra_velocity_ratio(double phi, double reynolds_inf) {
+  const double balance = (1 - phi) * (1 + 0.15 * std::pow(reynolds_inf, 0.687));
+  // x F(phi, Re_inf x) grows with x: bisection on (0, 2]
+  double lo = 0, hi = 2;
+  for (int k = 0; k < 100; ++k) {
+    const double x = 0.5 * (lo + hi);
+    (x * beetstra_drag(phi, reynolds_inf * x) < balance ? lo : hi) = x;
+  }
+  return 0.5 * (lo + hi);
+}
+
 double richardson_zaki_exponent(double re) {
   if (re < 0.2) return 4.65;
   if (re < 1) return 4.35 * std::pow(re, -0.03);

@@ -12,6 +12,13 @@ namespace flocsim::observables {
 // about 10 % scatter.
 double beetstra_drag(double phi, double reynolds);
 
+// The settling velocity U/U_inf at which Beetstra's drag holds the spheres up:
+// the force balance F_h = (1 - phi)(rho_p - rho) g V_p with U_inf from
+// Schiller-Naumann gives F = (1 - phi)(1 + 0.15 Re_inf^0.687) U_inf / U, solved
+// for U with F = beetstra_drag(phi, Re_inf U / U_inf). What a suspension whose
+// spheres felt the drag of a static random array would settle at.
+double beetstra_velocity_ratio(double phi, double reynolds_inf);
+
 // Richardson & Zaki (1954) hindered settling, U / U_inf = (1 - phi)^n with
 // n = 4.65 (Re < 0.2), 4.35 Re^-0.03 (0.2 <= Re < 1), 4.45 Re^-0.1
 // (1 <= Re < 500), 2.39 (Re >= 500), Re the single-sphere Re_inf. Settling

@@ -689,6 +689,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
       ref["richardson_zaki_U_over_Uinf"] =
           observables::richardson_zaki_velocity_ratio(phi, c.reynolds_inf);
       ref["richardson_zaki_exponent"] = observables::richardson_zaki_exponent(c.reynolds_inf);
+      ref["beetstra_U_over_Uinf"] = observables::beetstra_velocity_ratio(phi, c.reynolds_inf);
     }
     if (c.scene == "single-sphere" && c.box.nx == c.box.ny && c.box.ny == c.box.nz) {
       // creeping-flow hindrance of the simple cubic array the periodic box makes

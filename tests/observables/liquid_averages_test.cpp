@@ -109,6 +109,11 @@ TEST(ReferenceCorrelations, HandWorkedValues) {
   EXPECT_NEAR(richardson_zaki_exponent(12), 3.47090, 1e-5);
   EXPECT_NEAR(richardson_zaki_velocity_ratio(0.2, 12), 0.460930, 1e-6);
   EXPECT_DOUBLE_EQ(richardson_zaki_exponent(0.1), 4.65);
+  // Beetstra's settling velocity: x F(phi, Re_inf x) = (1 - phi)(1 + 0.15 Re_inf^0.687);
+  // at phi = 0.2, Re_inf = 12 the right side is 0.8 * 1.826968 = 1.461575, x = 0.322677
+  const double x = beetstra_velocity_ratio(0.2, 12);
+  EXPECT_NEAR(x, 0.322677, 1e-6);
+  EXPECT_NEAR(x * beetstra_drag(0.2, 12 * x), 0.8 * (1 + 0.15 * std::pow(12.0, 0.687)), 1e-12);
   EXPECT_DOUBLE_EQ(richardson_zaki_exponent(600), 2.39);
 }
 

@@ -130,6 +130,13 @@ TEST_F(Orchestrator, LaunchRunsTheGridAndQueryShowsEveryResult) {
   int n = 0;
   while (std::getline(lines, line)) ++n;
   EXPECT_EQ(n, 2) << q.out;  // x = 2 and 3
+  // Chosen columns, in the order given; an observable brings its error.
+  q = t::run(flocsim({"query", "--db", db_, "--columns", "twice_x,x", "--format", "csv"}));
+  ASSERT_EQ(q.code, 0) << q.out;
+  EXPECT_EQ(q.out.rfind("twice_x,twice_x_err,x\n", 0), 0u) << q.out;
+  q = t::run(flocsim({"query", "--db", db_, "--columns", "x,nosuch"}));
+  EXPECT_EQ(q.code, 2);
+  EXPECT_NE(q.out.find("--columns nosuch: no such column"), std::string::npos) << q.out;
   q = t::run(flocsim({"query", "--db", db_, "--where", "x=3"}));
   EXPECT_NE(q.out.find("6 ± 0.5"), std::string::npos) << q.out;
   EXPECT_NE(q.out.find("(1 of 4 runs)"), std::string::npos) << q.out;
