@@ -181,8 +181,10 @@ struct ImmersedBoundary<Real>::Workspace {
         target(static_cast<std::size_t>(markers)),
         marker_force(static_cast<std::size_t>(markers)),
         increment(static_cast<std::size_t>(markers) + 3),  // spread() reads 16 numbers
-        nearest(3 * static_cast<std::size_t>(markers)),
-        root(3 * static_cast<std::size_t>(markers)) {}
+        first(3 * static_cast<std::size_t>(markers)),
+        frac(3 * static_cast<std::size_t>(markers)),
+        root(3 * static_cast<std::size_t>(markers)),
+        packed(12 * static_cast<std::size_t>(markers)) {}
   int row_cells;  // box + 1: room for the fourth cell of a stencil row at the far end
   std::size_t cells;
   // u* = (rho, u*), state = (rho, v) (see Stencil), half_inv: 1 / (2 rho) four
@@ -192,9 +194,11 @@ struct ImmersedBoundary<Real>::Workspace {
   std::vector<std::size_t> base;                    // stencil corner of each marker (numbers)
   std::vector<V16> weights;                         // kernel weights of each marker
   std::vector<V4> target, marker_force, increment;  // (0, vector) per marker
-  std::vector<double> nearest, root;                // per marker and direction: kernel centre, q
-  std::vector<const Real*> lines;                   // cache lines of the next sphere
-  int fetched = -1;                                 // the sphere whose lines were fetched
+  std::vector<int> first;          // per direction and marker: first stencil cell in the box
+  std::vector<double> frac, root;  // per direction and marker: X - round(X), the root q
+  std::vector<Real> packed;        // per weight slot and marker, before packing
+  std::vector<const Real*> lines;  // cache lines of the next sphere
+  int fetched = -1;                // the sphere whose lines were fetched
 };
 
 template <class Real>
@@ -454,44 +458,53 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     std::size_t line = 0;
     const std::size_t lines_per_marker =
         ws.lines.size() / static_cast<std::size_t>(markers * iterations) + 1;
-    // Stencils (Roma weights, one square root per direction) and targets.
+    // Stencils (Roma weights, one square root per direction) and targets, in
+    // vector loops over the markers (arrays per direction), then packed.
     {
+      const int M = markers;
       const double* r = offsets_.data();
-      double* near = ws.nearest.data();
+      double* frac = ws.frac.data();  // X - round(X)
       double* q = ws.root.data();
-      const double c0 = centre[0], c1 = centre[1], c2 = centre[2];
+      int* first = ws.first.data();
+      const double c[3] = {centre[0], centre[1], centre[2]};
+      for (int d = 0; d < 3; ++d) {
 #pragma omp simd
-      for (int m = 0; m < markers; ++m) {
-        const double X[3] = {c0 + r[3 * m], c1 + r[3 * m + 1], c2 + r[3 * m + 2]};
-        for (int d = 0; d < 3; ++d) {
-          near[3 * m + d] = std::nearbyint(X[d]);
-          const double dd = X[d] - near[3 * m + d];
-          q[3 * m + d] = 1.0 - 3.0 * dd * dd;
+        for (int m = 0; m < M; ++m) {
+          const double X = c[d] + r[3 * m + d];
+          const double near = std::nearbyint(X);
+          first[d * M + m] = static_cast<int>(near) - 1 - lo[d];
+          const double f = X - near;
+          frac[d * M + m] = f;
+          q[d * M + m] = 1.0 - 3.0 * f * f;
         }
       }
-      sqrt_in_place(q, 3 * markers);
-    }
-    const double u0 = up[0], u1 = up[1], u2 = up[2];
-    const double o0 = omega[0], o1 = omega[1], o2 = omega[2];
-    for (int m = 0; m < markers; ++m) {
-      const std::size_t k = static_cast<std::size_t>(m);
-      const double* r = &offsets_[3 * k];
-      int first[3];
-      double w[3][3];
-      for (int d = 0; d < 3; ++d) {
-        const double near = ws.nearest[3 * k + d];
-        first[d] = static_cast<int>(near) - 1 - lo[d];
-        roma_weights_from_root(centre[d] + r[d] - near, ws.root[3 * k + d], w[d]);
+      sqrt_in_place(q, 3 * M);
+      Real* wt = ws.packed.data();  // 12 weights per marker, in slot order
+#pragma omp simd
+      for (int m = 0; m < M; ++m) {
+        double w[3][3];
+        for (int d = 0; d < 3; ++d) {
+          roma_weights_from_root(frac[d * M + m], q[d * M + m], w[d]);
+        }
+        for (int a = 0; a < 3; ++a) wt[a * M + m] = static_cast<Real>(w[0][a]);
+        for (int cc = 0; cc < 3; ++cc)
+          for (int b = 0; b < 3; ++b)
+            wt[(3 + b + 3 * cc) * M + m] = static_cast<Real>(w[1][b] * w[2][cc]);
       }
-      Real* wm = reinterpret_cast<Real*>(&ws.weights[k]);  // slots 12-15 stay zero
-      for (int a = 0; a < 3; ++a) wm[a] = static_cast<Real>(w[0][a]);
-      for (int c = 0; c < 3; ++c)
-        for (int b = 0; b < 3; ++b) wm[3 + b + 3 * c] = static_cast<Real>(w[1][b] * w[2][c]);
-      ws.base[k] = 4 * static_cast<std::size_t>(first[0] + R * (first[1] + B * first[2]));
-      ws.target[k] = V4{0, static_cast<Real>(u0 + o1 * r[2] - o2 * r[1]),
-                        static_cast<Real>(u1 + o2 * r[0] - o0 * r[2]),
-                        static_cast<Real>(u2 + o0 * r[1] - o1 * r[0])};
-      ws.marker_force[k] = V4{};
+      const double u0 = up[0], u1 = up[1], u2 = up[2];
+      const double o0 = omega[0], o1 = omega[1], o2 = omega[2];
+      for (int m = 0; m < M; ++m) {
+        const std::size_t k = static_cast<std::size_t>(m);
+        Real* wm = reinterpret_cast<Real*>(&ws.weights[k]);  // slots 12-15 stay zero
+        for (int l = 0; l < 12; ++l) wm[l] = wt[l * M + m];
+        ws.base[k] =
+            4 * static_cast<std::size_t>(first[m] + R * (first[M + m] + B * first[2 * M + m]));
+        const double* rm = &r[3 * m];
+        ws.target[k] = V4{0, static_cast<Real>(u0 + o1 * rm[2] - o2 * rm[1]),
+                          static_cast<Real>(u1 + o2 * rm[0] - o0 * rm[2]),
+                          static_cast<Real>(u2 + o0 * rm[1] - o1 * rm[0])};
+        ws.marker_force[k] = V4{};
+      }
     }
     // u* and 1/(2 rho) of the sphere's cells, from the pass.
     for (int k = 0; k < B; ++k)
@@ -577,6 +590,9 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     // weighted by w = min(1, a_g + 1/2 - |r|).
     double P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     const double reach = ag + 0.5;
+    // Cells with |r|^2 <= inner2 have reach - |r| >= 1 (margin for round-off
+    // of the square: such cells get w = 1 from the formula too).
+    const double inner2 = (ag - 0.5) * (ag - 0.5) * (1.0 - 1e-12);
     for (int k = 0; k < B; ++k) {
       const double rz = lo[2] + k - centre[2];
       if (std::abs(rz) >= reach) continue;
@@ -593,7 +609,8 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
         const Real* st = &ws.state[4 * static_cast<std::size_t>(R) * (j + B * k)];
         for (int i = i0; i <= i1; ++i) {
           const double rx = lo[0] + i - centre[0];
-          const double w = std::min(1.0, reach - std::sqrt(rx * rx + ry * ry + rz * rz));
+          const double r2 = rx * rx + ry * ry + rz * rz;  // w = 1 within a_g - 1/2: no sqrt
+          const double w = r2 <= inner2 ? 1.0 : std::min(1.0, reach - std::sqrt(r2));
           if (w <= 0) continue;
           const V4d c = __builtin_convertvector(Simd<Real>::template load<V4>(st + 4 * i), V4d);
           const V4d jc = (w * c[0]) * c;
