@@ -322,7 +322,15 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   contacts.set_counters(counters);
 }
 
-void write_series(const fs::path& dir, const RunState& s, int slabs) {
+// Distributions over the statistics window.
+struct Distributions {
+  std::vector<double> p;            // p(n_a), index n_a
+  std::vector<double> r_over_a, g;  // g(r)
+  std::vector<double> theta, h;     // h(theta), pairs closer than 3a
+};
+
+// series.h5: the time series, phi(x, t) and the steady distributions.
+void write_series(const fs::path& dir, const RunState& s, int slabs, const Distributions& d) {
   output::TemporaryFile tmp(dir / "series.h5");
   {
     output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
@@ -331,6 +339,12 @@ void write_series(const fs::path& dir, const RunState& s, int slabs) {
     // phi(x, t): rows are samples (times in /time), columns slabs of width L / slabs
     const auto slab_count = static_cast<hsize_t>(slabs);
     f.write("/phi_x", {s.phi_x.size() / slab_count, slab_count}, s.phi_x.data());
+    f.create_group("/distributions");
+    f.write("/distributions/size_distribution", {d.p.size()}, d.p.data());
+    f.write("/distributions/r_over_a", {d.r_over_a.size()}, d.r_over_a.data());
+    f.write("/distributions/g", {d.g.size()}, d.g.data());
+    f.write("/distributions/theta", {d.theta.size()}, d.theta.data());
+    f.write("/distributions/h", {d.h.size()}, d.h.data());
     f.close();
   }
   tmp.commit();
@@ -665,10 +679,6 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   progress.finish(s.step);
 
   // ---- output and result.json ----------------------------------------------------
-  Clock::time_point t0 = Clock::now();
-  write_series(o.out_dir, s, slabs);
-  if (liquid) write_fields(o.out_dir, liquid->fluid);
-  output_s += seconds_since(t0);
   nlohmann::json obs;
   obs["C_sph"] = steady(statistics_window(s, "C_sph"));
   obs["n_a_mean"] = steady(statistics_window(s, "mean_aggregate_size"));
@@ -718,20 +728,21 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
           (collisions.back() - collisions.front()) / c.sphere_count / span;
     }
   }
-  std::vector<double> p(s.size_distribution_sum.size());
+  Distributions dist;
   const double n_samples = static_cast<double>(statistics_window(s, "step").size());
-  for (std::size_t n = 0; n < p.size(); ++n)
-    p[n] = n_samples > 0 ? s.size_distribution_sum[n] / n_samples : 0.0;
-  while (p.size() > 2 && p.back() == 0.0) p.pop_back();
-  obs["size_distribution"] = p;
+  dist.p.resize(s.size_distribution_sum.size());
+  for (std::size_t n = 0; n < dist.p.size(); ++n)
+    dist.p[n] = n_samples > 0 ? s.size_distribution_sum[n] / n_samples : 0.0;
+  while (dist.p.size() > 2 && dist.p.back() == 0.0) dist.p.pop_back();
+  dist.r_over_a = s.microstructure.radial_bin_centres();
+  for (double& x : dist.r_over_a) x /= a;
+  dist.g = s.microstructure.radial_distribution();
+  dist.theta = s.microstructure.angular_bin_centres();
+  dist.h = s.microstructure.angular_distribution();
+  obs["size_distribution"] = dist.p;
   {
-    std::vector<double> r = s.microstructure.radial_bin_centres(),
-                        theta = s.microstructure.angular_bin_centres();
-    for (double& x : r) x /= a;
-    obs["g_r"] = {{"r_over_a", r}, {"g", s.microstructure.radial_distribution()}};
-    obs["h_theta"] = {{"theta", theta},
-                      {"h", s.microstructure.angular_distribution()},
-                      {"pairs_closer_than", "3a"}};
+    obs["g_r"] = {{"r_over_a", dist.r_over_a}, {"g", dist.g}};
+    obs["h_theta"] = {{"theta", dist.theta}, {"h", dist.h}, {"pairs_closer_than", "3a"}};
     obs["microstructure_configurations"] = s.microstructure.configurations();
   }
   obs["window"] = {{"start", s.statistics_start / c.convective_time},
@@ -748,6 +759,11 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                    {"edge_bounces", k.edge_bounces},
                    {"attached_pairs_final", contacts.attached_count()},
                    {"worst_overlap", contacts.worst_overlap()}};
+
+  Clock::time_point t0 = Clock::now();
+  write_series(o.out_dir, s, slabs, dist);
+  if (liquid) write_fields(o.out_dir, liquid->fluid);
+  output_s += seconds_since(t0);
 
   const double wall = seconds_since(t_start);
   const long steps_here = s.step - first_step;

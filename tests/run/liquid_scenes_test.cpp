@@ -96,6 +96,10 @@ TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
   // liquid + spheres momentum, float lattice sums over 44 000 cells: no drift
   // beyond round-off (1e-4 of the spheres' momentum scale N m_p U_inf)
   EXPECT_LT(obs["momentum_balance"]["relative_to_sphere_momentum"].get<double>(), 1e-4);
+  // series.h5 holds the distributions of result.json too
+  EXPECT_EQ(output::Hdf5File(dir / "series.h5", output::Hdf5File::Mode::read)
+                .read<double>("/distributions/size_distribution"),
+            p);
   // one final field snapshot and sphere snapshots every a/U_inf
   EXPECT_EQ(output::snapshot_steps(dir / "fields").size(), 1u);
   EXPECT_GE(output::snapshot_steps(dir / "spheres").size(), 3u);
@@ -160,6 +164,45 @@ TEST(LiquidScenes, SuspensionStopAndResumeIsBitIdentical) {
   }
   fs::remove_all(straight);
   fs::remove_all(split);
+}
+
+// The corners of the paper's grid (SPEC: phi 0.12-0.32, Re_inf 6-72, du/U_inf
+// up to 0.03), densest and most inertial with the strongest well, and dilute
+// and slow: the default numerics (nu = 0.005, tau = 0.515 at Re_inf = 72) stay
+// stable, spheres never overlap beyond the event engine's tolerance, and the
+// momentum of liquid + spheres does not drift. A short run at a = 4 in the
+// smallest box the case accepts, started from a random, non-overlapping placement.
+TEST(LiquidScenes, CornersOfTheParameterSpaceStayStable) {
+  struct Corner {
+    double phi, re_inf, du;
+  };
+  for (const Corner k : {Corner{0.32, 72, 0.03}, Corner{0.12, 6, 0.03}}) {
+    json j = json::parse(R"({
+      "scene": "suspension", "fidelity": "draft", "L_over_a": 14, "precision": "float",
+      "protocol": {"stage1_min": 1, "stage1_max": 1, "stage2_settle": 0.5, "statistics": 2,
+                   "sample_every": 0.1, "snapshot_every": 0}
+    })");
+    j["phi"] = k.phi;
+    j["Re_inf"] = k.re_inf;
+    j["du_over_Uinf"] = k.du;
+    const cases::SuspensionCase c = cases::parse_suspension_case(j);
+    const fs::path dir = fresh_dir("corner");
+    const RunReport r = run_sphere_case(c, {dir, false, true, 0});
+    ASSERT_EQ(r.outcome, RunOutcome::completed) << r.message;
+    const json& obs = r.result["observables"];
+    std::printf(
+        "phi %.2f Re_inf %g du %.2f (nu %.4f, tau %.3f, %d spheres, %ld steps): U/U_inf "
+        "%.3f, max overlap %.2e, momentum drift %.2e\n",
+        k.phi, k.re_inf, k.du, c.viscosity, 3 * c.viscosity + 0.5, c.sphere_count,
+        r.result["cost"]["steps"].get<long>(), obs["U_over_Uinf"]["mean"].get<double>(),
+        obs["events"]["worst_overlap"].get<double>(),
+        obs["momentum_balance"]["relative_to_sphere_momentum"].get<double>());
+    EXPECT_TRUE(std::isfinite(obs["U_over_Uinf"]["mean"].get<double>()));
+    EXPECT_GT(obs["U_over_Uinf"]["mean"].get<double>(), 0.0);
+    EXPECT_LE(obs["events"]["worst_overlap"].get<double>(), 1e-9);
+    EXPECT_LT(obs["momentum_balance"]["relative_to_sphere_momentum"].get<double>(), 1e-4);
+    fs::remove_all(dir);
+  }
 }
 
 // One sphere a = 4 in a periodic cube of 32 cells (chi = 2a/L = 1/4) at
