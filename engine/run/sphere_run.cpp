@@ -821,7 +821,20 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
     throw input::InputError("scene = \"" + c.scene +
                             "\": must be one of suspension, fixed-array, single-sphere, "
                             "granular, fluid");
-  return c.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
+  try {
+    return c.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
+  } catch (const input::InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // a module gave up (event cap, I/O): say so in the run's log too; the
+    // last checkpoint stays for a look or a --resume after the cause is fixed
+    RunReport r;
+    r.outcome = RunOutcome::failed;
+    r.message = e.what();
+    if (std::filesystem::is_directory(o.out_dir))
+      RunLog(o.out_dir / "run.log", true).error(r.message);
+    return r;
+  }
 }
 
 }  // namespace flocsim::run
