@@ -372,29 +372,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       c = c1;
     }
   };
-  // The pass and the spheres go together in slabs of z planes: after the
-  // pass over a slab, the spheres whose cells lie in the planes done so far
-  // (and not across the periodic z edge) are processed, while u* and the
-  // force-field lines of those planes are still in the last-level cache.
-  // Spheres across the z edge wait for the last slab.
-  const int planes = std::max(B, (e.nz + 7) / 8);
-  const int slabs = (e.nz + planes - 1) / planes;
-  std::vector<std::vector<int>> slab_spheres(static_cast<std::size_t>(slabs));
-  for (std::size_t s = 0; s < n; ++s) {
-    const int bottom = origins_[s][2], top = bottom + B - 1;
-    const int slab = bottom < 0 || top >= e.nz ? slabs - 1 : top / planes;
-    slab_spheres[static_cast<std::size_t>(slab)].push_back(static_cast<int>(s));
-  }
-  std::vector<std::vector<std::vector<std::vector<int>>>> slab_colours;
-  for (const auto& members : slab_spheres) {
-    std::vector<std::array<int, 3>> o;
-    for (int s : members) o.push_back(origins_[static_cast<std::size_t>(s)]);
-    auto colours = make_colours(o, B, e);
-    for (auto& blocks : colours)
-      for (auto& block : blocks)
-        for (int& k : block) k = members[static_cast<std::size_t>(k)];
-    slab_colours.push_back(std::move(colours));
-  }
+  const auto colours = make_colours(origins_, B, e);
 
   const int threads = omp_get_max_threads();
   if (static_cast<int>(workspaces_.size()) < threads)
@@ -656,37 +634,30 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   // Blocks of one colour in parallel, handed out one at a time; a thread
   // takes its next block before working on the current one, so that it knows
   // the next sphere and can fetch its lines early.
-  std::size_t colour_count = 0;
-  for (const auto& colours : slab_colours) colour_count += colours.size();
-  std::vector<std::atomic<std::size_t>> taken(colour_count);
+  std::vector<std::atomic<std::size_t>> taken(colours.size());
 #pragma omp parallel
   {
     Workspace& ws = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
     ws.fetched = -1;
-    std::size_t counter = 0;
-    for (int slab = 0; slab < slabs; ++slab) {
-      const std::size_t r0 = static_cast<std::size_t>(slab) * planes * e.ny;
-      const std::size_t r1 = std::min(lattice_rows, r0 + static_cast<std::size_t>(planes) * e.ny);
 #pragma omp for schedule(static)
-      for (std::size_t r = r0; r < r1; ++r) pass_row(r);
-      for (const auto& blocks : slab_colours[static_cast<std::size_t>(slab)]) {
-        std::atomic<std::size_t>& next_block = taken[counter++];
-        std::size_t block = next_block++;
-        while (block < blocks.size()) {
-          const std::size_t following = next_block++;
-          const auto& members = blocks[block];
-          for (std::size_t i = 0; i < members.size(); ++i) {
-            int next = -1;
-            if (i + 1 < members.size())
-              next = members[i + 1];
-            else if (following < blocks.size())
-              next = blocks[following].front();
-            process(ws, members[i], next);
-          }
-          block = following;
+    for (std::size_t r = 0; r < lattice_rows; ++r) pass_row(r);
+    for (std::size_t c = 0; c < colours.size(); ++c) {
+      const auto& blocks = colours[c];
+      std::size_t block = taken[c]++;
+      while (block < blocks.size()) {
+        const std::size_t following = taken[c]++;
+        const auto& members = blocks[block];
+        for (std::size_t i = 0; i < members.size(); ++i) {
+          int next = -1;
+          if (i + 1 < members.size())
+            next = members[i + 1];
+          else if (following < blocks.size())
+            next = blocks[following].front();
+          process(ws, members[i], next);
         }
-#pragma omp barrier
+        block = following;
       }
+#pragma omp barrier
     }
   }
   if (!zero_in_pass) held_.assign(lattice_rows * words, 0);
