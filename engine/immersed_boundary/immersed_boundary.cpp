@@ -310,7 +310,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   // some point of the sphere |X - centre| = a_g. Per box row: the cells whose
   // cube meets the ball of radius a_g (holes filled; this includes the inside,
   // |r| < a_g + 1/2, that the momentum sums need).
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 16)
   for (std::size_t s = 0; s < n; ++s) {
     const Vec3 centre = spheres.position[s];
     const auto& lo = origins_[s];
@@ -639,7 +639,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
   {
     Workspace& ws = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
     ws.fetched = -1;
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, 64)
     for (std::size_t r = 0; r < lattice_rows; ++r) pass_row(r);
     for (std::size_t c = 0; c < colours.size(); ++c) {
       const auto& blocks = colours[c];
