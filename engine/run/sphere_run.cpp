@@ -298,8 +298,12 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
         unflatten(f.read<double>("/spheres/internal_momentum")),
         unflatten(f.read<double>("/spheres/internal_angular_momentum")));
   }
-  for (std::size_t col = 0; col < s.series.names.size(); ++col)
-    s.series.data[col] = f.read<double>("/series/" + s.series.names[col]);
+  for (std::size_t col = 0; col < s.series.names.size(); ++col) {
+    std::string name = "/series/" + s.series.names[col];
+    // checkpoints written before C_sph had its SPEC name
+    if (s.series.names[col] == "C_sph" && !f.exists(name)) name = "/series/contacts_per_sphere";
+    s.series.data[col] = f.read<double>(name);
+  }
   s.size_distribution_sum = f.read<double>("/size_distribution_sum");
   observables::PairStructure::Accumulated m;
   m.g_counts = f.read<double>("/microstructure/g_counts");
