@@ -11,6 +11,7 @@
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
+#include "engine/observables/reference_correlations.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
 #include "ib_test_support.hpp"
 
@@ -137,18 +138,9 @@ namespace {
 
 using spheres::Vec3;
 
-// Beetstra, van der Hoef & Kuipers (2007), paper eq. 4 with its Stokes part
-// (van der Hoef et al. 2005): F = F_h / (6 pi mu a U), F_h without the mean
-// pressure gradient (= f V_p (1/phi - 1) for a body-force driven bed), U the
-// superficial velocity, Re = U 2a / nu.
-double beetstra_drag(double phi, double re) {
-  const double s = 1 - phi;
-  const double f0 = 10 * phi / (s * s) + s * s * (1 + 1.5 * std::sqrt(phi));
-  const double inertial = 0.413 * re / (24 * s * s) *
-                          (1 / s + 3 * phi * s + 8.4 * std::pow(re, -0.343)) /
-                          (1 + std::pow(10.0, 3 * phi) * std::pow(re, -(1 + 4 * phi) / 2));
-  return f0 + inertial;
-}
+// Beetstra, van der Hoef & Kuipers (2007), paper eq. 4, in the normalisation
+// F = F_h / (6 pi mu a U), F_h = f V_p (1/phi - 1) (engine/observables).
+using observables::beetstra_drag;
 
 // A static random array (random sequential addition, no overlap) of spheres
 // a = 4 dx in a 48^3 periodic box, nu = 0.02 (U = 0.025 at Re = 10), liquid driven by a body force
