@@ -12,6 +12,7 @@
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/stop_signal.hpp"
@@ -85,10 +86,7 @@ void write_checkpoint(const fs::path& dir, const FluidLattice<Real>& fluid,
   output::TemporaryFile tmp(dir / "checkpoint.h5");
   {
     output::Hdf5File f(tmp.path(), output::Hdf5File::Mode::create);
-    f.create_group("/fluid");
-    const std::vector<hsize_t> shape = {static_cast<hsize_t>(fluid.extent().cells())};
-    for (int i = 0; i < d3q19::kQ; ++i)
-      f.write("/fluid/population_deviation_" + std::to_string(i), shape, fluid.storage(i));
+    save_populations(f, fluid);
     f.set_attribute("/", "time_step", static_cast<std::int64_t>(fluid.time_step()));
     f.set_attribute("/", "case", c.to_json().dump());
     f.set_attribute("/", "precision", std::string(sizeof(Real) == 8 ? "double" : "float"));
@@ -110,12 +108,7 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
   if (!resumable_under(nlohmann::json::parse(f.attribute_string("/", "case")), c.to_json()))
     throw input::InputError(
         file.string() + " belongs to a different case; remove it or use another --out directory");
-  for (int i = 0; i < d3q19::kQ; ++i) {
-    const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
-    if (static_cast<long>(data.size()) != fluid.extent().cells())
-      throw std::runtime_error(file.string() + ": population array has the wrong size");
-    std::copy(data.begin(), data.end(), fluid.storage(i));
-  }
+  restore_populations(f, fluid, file);
   fluid.set_time_step(f.attribute_int("/", "time_step"));
   base.mass = f.attribute_double("/", "baseline_mass");
   base.momentum = {f.attribute_double("/", "baseline_momentum_x"),
@@ -123,15 +116,6 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
                    f.attribute_double("/", "baseline_momentum_z")};
   base.amplitude = f.attribute_double("/", "baseline_amplitude");
   base.wall_s = f.attribute_double("/", "wall_s");
-}
-
-template <class Real>
-void write_fields(const fs::path& dir, const FluidLattice<Real>& fluid) {
-  std::vector<double> rho, ux, uy, uz;
-  fluid.macroscopic_fields(rho, ux, uy, uz);
-  const auto e = fluid.extent();
-  output::write_field_snapshot(dir / "fields",
-                               {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
 }
 
 template <class Real>
@@ -185,19 +169,10 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     if (t % health_every == 0 || t == c.run.steps) {
       const double mass = fluid.total_mass();
       if (!std::isfinite(mass)) {
-        RunReport r;
-        r.outcome = RunOutcome::failed;
-        r.message =
-            "numerical blow-up detected at step " + std::to_string(t) +
-            ": the liquid mass is no longer finite. " +
-            (last_good_checkpoint_step >= 0
-                 ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint_step) +
-                       ") is kept in " + checkpoint.string() + ". "
-                 : std::string("No checkpoint had been written yet. ")) +
-            "Likely causes: velocities beyond the Mach limit or a viscosity too small for the "
-            "resolution.";
-        log.error(r.message);
-        return r;
+        return blown_up_run(log, "step " + std::to_string(t), "the liquid mass is no longer finite",
+                            last_good_checkpoint_step, checkpoint,
+                            "velocities beyond the Mach limit or a viscosity too small for the "
+                            "resolution");
       }
     }
     if (c.run.write_fields && c.run.fields_every > 0 && t % c.run.fields_every == 0 &&

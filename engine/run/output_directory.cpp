@@ -59,4 +59,19 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
   return physics_only(checkpoint_case) == physics_only(current_case);
 }
 
+RunReport blown_up_run(RunLog& log, const std::string& where, const std::string& what,
+                       long last_good_checkpoint, const std::filesystem::path& checkpoint,
+                       const std::string& likely_causes) {
+  RunReport r;
+  r.outcome = RunOutcome::failed;
+  r.message = "numerical blow-up detected at " + where + ": " + what + ". " +
+              (last_good_checkpoint >= 0
+                   ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint) +
+                         ") is kept in " + checkpoint.string() + ". "
+                   : std::string("No checkpoint had been written yet. ")) +
+              "Likely causes: " + likely_causes + ".";
+  log.error(r.message);
+  return r;
+}
+
 }  // namespace flocsim::run

@@ -24,6 +24,13 @@ StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume
 // stored result.json, untouched.
 RunReport completed_run(const std::filesystem::path& dir, RunLog& log);
 
+// The report of a run stopped by a numerical blow-up: what happened where,
+// whether a last good checkpoint (step >= 0) is kept, and the likely causes;
+// also written to the log.
+RunReport blown_up_run(RunLog& log, const std::string& where, const std::string& what,
+                       long last_good_checkpoint, const std::filesystem::path& checkpoint,
+                       const std::string& likely_causes);
+
 // Now, as result.json's completed_at: ISO 8601 in UTC.
 std::string utc_timestamp();
 

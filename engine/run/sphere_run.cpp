@@ -26,6 +26,7 @@
 #include "engine/output/hdf5_file.hpp"
 #include "engine/output/sphere_snapshots.hpp"
 #include "engine/placement/random_placement.hpp"
+#include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/stop_signal.hpp"
@@ -220,11 +221,7 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
     if (liquid) {
       // the lattice populations, and the inside-liquid momenta whose change
       // the first resumed step feeds to the sphere equations
-      f.create_group("/fluid");
-      const std::vector<hsize_t> shape = {static_cast<hsize_t>(liquid->fluid.extent().cells())};
-      for (int i = 0; i < d3q19::kQ; ++i)
-        f.write("/fluid/population_deviation_" + std::to_string(i), shape,
-                liquid->fluid.storage(i));
+      save_populations(f, liquid->fluid);
       f.set_attribute("/fluid", "time_step", static_cast<std::int64_t>(liquid->fluid.time_step()));
       f.write("/spheres/internal_momentum", {n, 3}, flatten(liquid->ib.internal_momentum()).data());
       f.write("/spheres/internal_angular_momentum", {n, 3},
@@ -287,12 +284,7 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   counters.neighbour_rebuilds = static_cast<std::uint64_t>(k[4]);
   counters.steps = static_cast<std::uint64_t>(k[5]);
   if (liquid) {
-    for (int i = 0; i < d3q19::kQ; ++i) {
-      const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
-      if (static_cast<long>(data.size()) != liquid->fluid.extent().cells())
-        throw std::runtime_error(file.string() + ": population array has the wrong size");
-      std::copy(data.begin(), data.end(), liquid->fluid.storage(i));
-    }
+    restore_populations(f, liquid->fluid, file);
     liquid->fluid.set_time_step(f.attribute_int("/fluid", "time_step"));
     liquid->ib.set_internal_momenta(
         unflatten(f.read<double>("/spheres/internal_momentum")),
@@ -352,15 +344,6 @@ void write_series(const fs::path& dir, const RunState& s, int slabs, const Distr
     f.close();
   }
   tmp.commit();
-}
-
-template <class Real>
-void write_fields(const fs::path& dir, const lattice::FluidLattice<Real>& fluid) {
-  std::vector<double> rho, ux, uy, uz;
-  fluid.macroscopic_fields(rho, ux, uy, uz);
-  const auto e = fluid.extent();
-  output::write_field_snapshot(dir / "fields",
-                               {fluid.time_step(), e.nx, e.ny, e.nz, &rho, &ux, &uy, &uz});
 }
 
 // The samples of one column taken after the statistics started.
@@ -502,19 +485,12 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   double worst_momentum_drift = 0;
 
   auto fail = [&](const std::string& what) {
-    RunReport r;
-    r.outcome = RunOutcome::failed;
-    r.message = "numerical blow-up at step " + std::to_string(s.step) +
-                " (t U_inf/a = " + std::to_string(s.step / c.convective_time) + "): " + what +
-                ". " +
-                (last_good_checkpoint >= 0
-                     ? "The last good checkpoint (step " + std::to_string(last_good_checkpoint) +
-                           ") is kept in " + checkpoint.string() + ". "
-                     : std::string("No checkpoint had been written yet. ")) +
-                "Likely causes: U_inf too high for the Mach limit, a viscosity too small for "
-                "the resolution, or a density ratio near 1.";
-    log.error(r.message);
-    return r;
+    return blown_up_run(log,
+                        "step " + std::to_string(s.step) +
+                            " (t U_inf/a = " + std::to_string(s.step / c.convective_time) + ")",
+                        what, last_good_checkpoint, checkpoint,
+                        "U_inf too high for the Mach limit, a viscosity too small for the "
+                        "resolution, or a density ratio near 1");
   };
 
   while (!done) {
