@@ -257,4 +257,21 @@ const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, dou
   return *best;
 }
 
+double CalibrationTable::input_radius(double hydrodynamic_radius, double viscosity,
+                                      double marker_spacing, int iterations) const {
+  const CalibrationEntry& nearest =
+      lookup(hydrodynamic_radius, viscosity, marker_spacing, iterations);
+  const CalibrationEntry *below = nullptr, *above = nullptr;
+  for (const auto& e : entries_) {
+    if (std::abs(e.hydrodynamic_radius - hydrodynamic_radius) > 1e-6) continue;
+    if (std::abs(e.marker_spacing - marker_spacing) > 1e-9 || e.iterations != iterations) continue;
+    if (e.viscosity <= viscosity && (!below || e.viscosity > below->viscosity)) below = &e;
+    if (e.viscosity >= viscosity && (!above || e.viscosity < above->viscosity)) above = &e;
+  }
+  if (!below || !above || below->viscosity == above->viscosity) return nearest.input_radius;
+  const double s = std::log(viscosity / below->viscosity) /
+                   std::log(above->viscosity / below->viscosity);
+  return below->input_radius + s * (above->input_radius - below->input_radius);
+}
+
 }  // namespace flocsim::calibration

@@ -93,6 +93,13 @@ class CalibrationTable {
   // entry has that a.
   const CalibrationEntry& lookup(double hydrodynamic_radius, double viscosity,
                                  double marker_spacing = 0.7, int iterations = 2) const;
+  // The input radius for a at nu: between the two entries (same a, spacing and
+  // iterations) whose viscosities bracket nu, a_g interpolated linearly in
+  // log(nu) (the offset a - a_g varies smoothly with log nu: 0.431 to 0.388 dx
+  // from nu = 0.005 to 1/6 at a = 6); outside the calibrated viscosities, the
+  // nearest entry's a_g (no extrapolation). Throws like lookup().
+  double input_radius(double hydrodynamic_radius, double viscosity, double marker_spacing = 0.7,
+                      int iterations = 2) const;
   std::string note;  // how the table was made
 
  private:

@@ -166,11 +166,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                          format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
 
   if (c.scene != "granular" && !c.input_radius_given) {
-    // a_g for this a from the shipped calibration (nearest calibrated viscosity)
+    // a_g for this a from the shipped calibration, interpolated in log(nu)
+    // between the calibrated viscosities around this one
     try {
-      const auto& entry = calibration::CalibrationTable::shipped().lookup(a, c.viscosity);
-      c.input_radius = entry.input_radius;
-      c.calibration_viscosity = entry.viscosity;
+      const auto& table = calibration::CalibrationTable::shipped();
+      c.input_radius = table.input_radius(a, c.viscosity);
+      c.calibration_viscosity = table.lookup(a, c.viscosity).viscosity;
     } catch (const std::out_of_range& e) {
       throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
                        " Or give numerics.input_radius (the marker radius a_g) yourself.");
@@ -308,8 +309,10 @@ nlohmann::json SuspensionCase::derived_json() const {
           {"input_radius", input_radius},
           {"input_radius_from", input_radius_given    ? std::string("numerics.input_radius")
                                 : scene == "granular" ? std::string("unused (no liquid)")
-                                                      : "shipped calibration at nu = " +
-                                                            format_value(calibration_viscosity)}};
+                                                      : "shipped calibration, interpolated in "
+                                                        "log nu (nearest entry nu = " +
+                                                            format_value(calibration_viscosity) +
+                                                            ")"}};
 }
 
 }  // namespace flocsim::cases

@@ -56,10 +56,11 @@ struct SuspensionCase {
   double trt_magic = 0.25;
   // Marker radius a_g of the immersed boundary, which gives hydrodynamic
   // radius a: numerics.input_radius, or looked up in the shipped calibration
-  // table (engine/calibration) at the nearest calibrated viscosity.
+  // table (engine/calibration), interpolated in log(nu) between the calibrated
+  // viscosities around this one (the nearest entry's a_g outside them).
   double input_radius = 0;
   bool input_radius_given = false;
-  double calibration_viscosity = 0;  // viscosity of the table entry used
+  double calibration_viscosity = 0;  // viscosity of the nearest table entry
 
   // ---- protocol (durations in a / U_inf) -------------------------------------
   double stage1_min = 20;     // du = 0 stage: at least this long ...

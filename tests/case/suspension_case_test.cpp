@@ -136,8 +136,9 @@ TEST(SuspensionCase, BadInputsAreNamed) {
 }
 
 // The marker radius a_g comes from the shipped calibration table (values in
-// engine/calibration/hydrodynamic_radius.json: a = 6 at nu = 0.02 and 1/6), or
-// from numerics.input_radius; an uncalibrated a is refused before any work.
+// engine/calibration/hydrodynamic_radius.json: a = 6 at nu = 0.005 - 1/6),
+// interpolated in log nu, or from numerics.input_radius; an uncalibrated a is
+// refused before any work.
 TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
   SuspensionCase c = parse_suspension_case(
       {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"viscosity", 0.02}}}});
@@ -145,7 +146,10 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
   EXPECT_DOUBLE_EQ(c.calibration_viscosity, 0.02);
   c = parse_suspension_case(
       {{"scene", "single-sphere"}, {"Re_inf", 1}, {"numerics", {{"viscosity", 0.15}}}});  // 1/6
-  EXPECT_NEAR(c.input_radius, 5.6120, 1e-4);
+  // between the entries at nu = 0.08 (a_g 5.593528) and 1/6 (5.612012), by hand:
+  // 5.593528 + ln(0.15 / 0.08) / ln((1/6) / 0.08) (5.612012 - 5.593528) = 5.609359
+  EXPECT_NEAR(c.input_radius, 5.609359, 2e-6);
+  EXPECT_DOUBLE_EQ(c.calibration_viscosity, 1.0 / 6.0);
   c = parse_suspension_case({{"scene", "fixed-array"},
                              {"phi", 0.2},
                              {"numerics", {{"a_over_dx", 5}, {"input_radius", 4.6}}}});

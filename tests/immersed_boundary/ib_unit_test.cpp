@@ -159,6 +159,28 @@ TEST(SanganiAcrivos, RadiusFromDragInvertsTheSeries) {
   EXPECT_NEAR(calibration::hydrodynamic_radius_from_drag(F, U, nu, L), a, 1e-9);
 }
 
+TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates) {
+  // Hand-made table: a = 6 at nu = 0.01 and 0.04 (a_g 5.57 and 5.59), a = 4 at
+  // nu = 0.02, and an a = 6 entry with one sweep that must not be mixed in.
+  const auto table = calibration::CalibrationTable::parse(R"({"entries": [
+    {"hydrodynamic_radius": 6, "viscosity": 0.01, "input_radius": 5.57, "marker_spacing": 0.7, "iterations": 2},
+    {"hydrodynamic_radius": 6, "viscosity": 0.04, "input_radius": 5.59, "marker_spacing": 0.7, "iterations": 2},
+    {"hydrodynamic_radius": 6, "viscosity": 0.02, "input_radius": 5.00, "marker_spacing": 0.7, "iterations": 1},
+    {"hydrodynamic_radius": 4, "viscosity": 0.02, "input_radius": 3.53, "marker_spacing": 0.7, "iterations": 2}]})",
+                                                          "test table");
+  // nu = 0.02 is halfway between 0.01 and 0.04 in log nu: the mean a_g.
+  EXPECT_NEAR(table.input_radius(6, 0.02), 5.58, 1e-12);
+  // a quarter of the way: log(0.01 sqrt(2)) = log 0.01 + (1/4) log 4
+  EXPECT_NEAR(table.input_radius(6, 0.01 * std::sqrt(2.0)), 5.575, 1e-12);
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.01), 5.57);   // at an entry: that entry
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.04), 5.59);
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.005), 5.57);  // outside: the nearest entry
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.5), 5.59);
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, 0.7, 1), 5.00);  // sweeps are a separate scheme
+  EXPECT_DOUBLE_EQ(table.input_radius(4, 0.001), 3.53);
+  EXPECT_THROW(table.input_radius(5, 0.02), std::out_of_range);
+}
+
 TEST(SettlingForces, BalanceOfSpecSectionOne) {
   // f V (1 - phi) = N (rho_p - rho_bar) V_p g, with the SPEC's definitions.
   const std::size_t n = 37;
