@@ -1,12 +1,14 @@
 // Long physics checks of the immersed-boundary spheres (label slow): the
 // simple-cubic-array drag against Sangani & Acrivos over phi = 0.01 - 0.2 at
-// a = 4, 6 and 8 dx with the calibrated input radii, and a single sphere
-// settling at Re_inf = 12 against Schiller-Naumann.
+// a = 4, 6 and 8 dx with the calibrated input radii, a single sphere settling
+// at Re_inf = 12 against Schiller-Naumann, and at Re_inf = 24 and 72 with a wake
+// sponge in two box widths.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
@@ -14,6 +16,7 @@
 #include "engine/observables/reference_correlations.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
 #include "ib_test_support.hpp"
+#include "wake_sponge.hpp"
 
 namespace flocsim {
 namespace {
@@ -128,6 +131,99 @@ TEST(SettlingSphere, SchillerNaumannAtRe12TwoBoxSizes) {
   const double small = settling_velocity_ratio(48);
   const double large = settling_velocity_ratio(64);
   EXPECT_GT(large, small - 0.005);  // a larger box hinders less
+}
+
+// One sphere at the paper's resolution (a = 6 dx, rho_p/rho = 4, U_inf = 0.05)
+// settling from rest at Re_inf = 24 or 72 in a periodic box 16a long and W
+// wide, with the wake sponge (wake_sponge.hpp) half a box behind it: without
+// it the sphere drafts in its own periodic wake and never reaches a terminal
+// velocity. Returns the slip U (against the mean liquid velocity) over the
+// Schiller-Naumann velocity for the sphere's net weight, extrapolated in time
+// (Aitken, from t = t_end - 10, - 5, t_end in a/U_inf, where the increments
+// shrink geometrically; else the value at t_end).
+double sponge_settling_ratio(double re_inf, double W_over_a, double t_end) {
+  const double a = 6.0, ratio = 4.0, u_inf = 0.05;
+  const double nu = 2 * a * u_inf / re_inf;
+  const double ag = test::calibrated_input_radius(a, nu);
+  const int L = static_cast<int>(16 * a), W = static_cast<int>(W_over_a * a);
+  lattice::FluidLattice<float> fluid({L, W, W}, {nu, 0.25});
+  immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
+  test::WakeSponge<float> sponge(0.1, 8);
+  spheres::SphereSet s;
+  s.radius = a;
+  s.density_ratio = ratio;
+  s.resize(1);
+  s.position[0] = Vec3(0.75 * L + 0.3, 0.5 * W + 0.2, 0.5 * W - 0.1);
+  const spheres::PeriodicBox box{Vec3(L, W, W)};
+  const double cd = 24 / re_inf * (1 + 0.15 * std::pow(re_inf, 0.687));
+  const double g = 0.375 * cd / (ratio - 1) * u_inf * u_inf / a;  // SPEC section 2
+  spheres::SphereDynamicsSettings dyn;
+  dyn.external = spheres::settling_forces(1, a, ratio, box.volume(), g);
+  fluid.set_body_force({dyn.external.liquid_body_force.x(), 0, 0});
+  const double weight = -dyn.external.net_gravity.x();
+  double u_sn = u_inf;
+  for (int it = 0; it < 100; ++it) {
+    const double re = u_sn * 2 * a / nu;
+    u_sn = weight / (6 * M_PI * nu * a * (1 + 0.15 * std::pow(re, 0.687)));
+  }
+  const double phi = s.volume() / box.volume();
+  const int every = static_cast<int>(std::lround(5 * a / u_inf));  // 5 a / U_inf
+  const int steps = static_cast<int>(std::lround(t_end / 5)) * every;
+  std::vector<double> series;
+  for (int step = 1; step <= steps; ++step) {
+    ib.apply(fluid, s);
+    sponge.apply(fluid, s.position[0].x(), ag + 1.5);
+    fluid.step();
+    spheres::advance_velocities(s,
+                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
+                                 ib.internal_angular_momentum_change()},
+                                dyn);
+    spheres::advance_positions(s, box);
+    if (step % every == 0) {
+      const double liquid = -phi * ratio * s.velocity[0].x() / (1 - phi);
+      series.push_back((liquid - s.velocity[0].x()) / u_sn);
+    }
+  }
+  const std::size_t n = series.size();
+  const double x0 = series[n - 3], x1 = series[n - 2], x2 = series[n - 1];
+  // Aitken only where the increments shrink geometrically (0 < ratio < 1);
+  // otherwise (noise-level or growing increments) the last value.
+  const double ratio_of_increments = (x1 - x0) != 0 ? (x2 - x1) / (x1 - x0) : 0.0;
+  const double limit = ratio_of_increments > 0 && ratio_of_increments < 0.9
+                           ? x2 + (x2 - x1) * ratio_of_increments / (1 - ratio_of_increments)
+                           : x2;
+  std::printf(
+      "settling with wake sponge, a = 6, Re_inf = %g, box 16a x %ga x %ga: U/U_SN at t = %g, "
+      "%g, %g: %.4f %.4f %.4f -> %.4f (Re %.2f)\n",
+      re_inf, W_over_a, W_over_a, t_end - 10, t_end - 5, t_end, x0, x1, x2, limit,
+      limit * u_sn * 2 * a / nu);
+  std::fflush(stdout);
+  return limit;
+}
+
+// The box-size effect with the wake removed: W = 12a and 16a (a 16a long box).
+// Reference: Schiller-Naumann. It fits the standard drag curve to about 5 %
+// (Clift, Grace & Weber 1978); here the standard curve's own correlation,
+// C_D = 24/Re (1 + 0.1935 Re^0.6305) for 20 < Re < 260, lies 4.6 % (Re = 23)
+// to 1.3 % (Re = 69) above it, i.e. an isolated sphere's velocity is 1-3 %
+// below U_SN. Asserted: U/U_SN in [0.94, 1.03] in the wider box (U_SN's 5 %
+// in drag, about 3.5 % in velocity, widened on the low side by the 3 % the
+// standard curve sits below U_SN), and the box effect converged: the wider box
+// within 1 % of the narrower one and not slower.
+void sponge_settling_check(double re_inf, double t_end) {
+  const double narrow = sponge_settling_ratio(re_inf, 12, t_end);
+  const double wide = sponge_settling_ratio(re_inf, 16, t_end);
+  EXPECT_GT(wide, 0.94);
+  EXPECT_LT(wide, 1.03);
+  EXPECT_GT(wide, narrow - 0.002);
+  EXPECT_LT(wide - narrow, 0.01);
+}
+
+TEST(SettlingSphereWithWakeSponge, SchillerNaumannAtRe24) {
+  sponge_settling_check(24, 50);
+}
+TEST(SettlingSphereWithWakeSponge, SchillerNaumannAtRe72) {
+  sponge_settling_check(72, 60);
 }
 
 }  // namespace

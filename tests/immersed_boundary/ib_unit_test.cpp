@@ -15,6 +15,7 @@
 #include "engine/immersed_boundary/kernel.hpp"
 #include "engine/immersed_boundary/sphere_markers.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
+#include "wake_sponge.hpp"
 
 namespace flocsim {
 namespace {
@@ -179,6 +180,82 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, 0.7, 1), 5.00);  // sweeps are a separate scheme
   EXPECT_DOUBLE_EQ(table.input_radius(4, 0.001), 3.53);
   EXPECT_THROW(table.input_radius(5, 0.02), std::out_of_range);
+}
+
+// The validation runs' wake sponge (wake_sponge.hpp): its forces sum to zero,
+// so a lattice with the sponge keeps the momentum of a twin without it; it
+// relaxes the slab's velocity towards the slab mean; and it takes back its old
+// force when the slab moves with the sphere.
+TEST(WakeSponge, ConservesMomentumMixesTheSlabAndRemovesItsOldForce) {
+  const lattice::Extent e{48, 8, 8};
+  lattice::FluidLattice<double> with(e, {0.02, 0.25}), without(e, {0.02, 0.25});
+  // A shear wave u_x = U0 sin(2 pi y / 8) on a uniform stream: a velocity
+  // spread across every y-z slab that viscosity alone takes 1/(nu k^2) = 81
+  // steps to damp.
+  for (auto* f : {&with, &without}) {
+    f->enable_force_field();
+    f->initialise_equilibrium([&](int, int y, int) {
+      return lattice::Macroscopic{1.0, {0.01 + 0.01 * std::sin(2 * M_PI * y / 8), 0.002, -0.001}};
+    });
+  }
+  // Velocity spread (sum of squared deviations from the slab mean) over x = 22..25.
+  auto spread = [&](const lattice::FluidLattice<double>& f) {
+    double mass = 0, p[3] = {0, 0, 0};
+    std::vector<lattice::Macroscopic> m;
+    for (int x = 22; x < 26; ++x)
+      for (int z = 0; z < e.nz; ++z)
+        for (int y = 0; y < e.ny; ++y) {
+          m.push_back(f.macroscopic_without_force_field(x, y, z));
+          mass += m.back().density;
+          p[0] += m.back().density * m.back().velocity.x;
+          p[1] += m.back().density * m.back().velocity.y;
+          p[2] += m.back().density * m.back().velocity.z;
+        }
+    double s = 0;
+    for (const auto& c : m)
+      s += std::pow(c.velocity.x - p[0] / mass, 2) + std::pow(c.velocity.y - p[1] / mass, 2) +
+           std::pow(c.velocity.z - p[2] / mass, 2);
+    return s;
+  };
+  test::WakeSponge<double> sponge(0.5, 4);
+  sponge.apply(with, 0.3, 2.0);  // slab x = 22..25, half a box from the sphere
+  for (double F : sponge.total_force()) EXPECT_NEAR(F, 0.0, 1e-15);
+  for (int x = 0; x < e.nx; ++x) {  // force on the slab only
+    const bool in_slab = x >= 22 && x < 26;
+    double sum = 0;
+    for (int z = 0; z < e.nz; ++z)
+      for (int y = 0; y < e.ny; ++y) sum += std::abs(with.force_field(0)[with.cell_index(x, y, z)]);
+    EXPECT_EQ(sum > 0, in_slab) << "x = " << x;
+  }
+  for (int step = 0; step < 20; ++step) {
+    if (step > 0) sponge.apply(with, 0.3, 2.0);
+    with.step();
+    without.step();
+  }
+  // Momentum: the lattice's total (which adds half of the force field) after
+  // removing the sponge's last force, so both lattices read the same way.
+  sponge.apply(with, 0.3, 2.0);
+  const auto last = sponge.total_force();
+  lattice::Vector3 pw = with.total_momentum();
+  pw.x -= 0.5 * last[0], pw.y -= 0.5 * last[1], pw.z -= 0.5 * last[2];
+  // Tolerance: double round-off of momenta of size |p| = 31 summed over 3072
+  // cells and 20 steps, eps |p| sqrt(3072 x 20) = 2e-12.
+  const lattice::Vector3 po = without.total_momentum();
+  EXPECT_NEAR(pw.x, po.x, 2e-12);
+  EXPECT_NEAR(pw.y, po.y, 2e-12);
+  EXPECT_NEAR(pw.z, po.z, 2e-12);
+  // After 20 steps viscosity alone leaves (1 - 20/81)^2 ~ 0.6 of the spread;
+  // the sponge (half the deviation per step on the slab) leaves far less.
+  const double ratio = spread(with) / spread(without);
+  std::printf("slab velocity spread after 20 steps, with / without sponge: %.3f\n", ratio);
+  EXPECT_LT(ratio, 0.2);
+  // The sphere moves 5 cells: the slab moves to x = 27..30 and x = 22..26 is clear again.
+  sponge.apply(with, 5.3, 2.0);
+  for (int x = 22; x < 27; ++x)
+    for (int z = 0; z < e.nz; ++z)
+      for (int y = 0; y < e.ny; ++y)
+        for (int d = 0; d < 3; ++d) EXPECT_EQ(with.force_field(d)[with.cell_index(x, y, z)], 0.0);
+  EXPECT_THROW(sponge.apply(with, 0.3, 10.0), std::invalid_argument);  // slab would meet the sphere
 }
 
 TEST(SettlingForces, BalanceOfSpecSectionOne) {
