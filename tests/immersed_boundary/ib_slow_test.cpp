@@ -62,6 +62,49 @@ namespace {
 
 using spheres::Vec3;
 
+// One sphere (rho_p/rho = 4) about to settle from rest along x in a periodic
+// box L x W x W, gravity set so that Schiller-Naumann gives U_inf (SPEC
+// section 2), and the Schiller-Naumann velocity U_SN for the sphere's actual
+// net weight (rho_p - rho_bar) V g.
+struct SettlingSphere {
+  SettlingSphere(double a, double nu, double re_inf, double u_inf, int L, int W)
+      : box{Vec3(L, W, W)} {
+    const double ratio = 4.0;
+    s.radius = a;
+    s.density_ratio = ratio;
+    s.resize(1);
+    s.position[0] = Vec3(0.75 * L + 0.3, 0.5 * W + 0.2, 0.5 * W - 0.1);
+    const double cd = 24 / re_inf * (1 + 0.15 * std::pow(re_inf, 0.687));
+    const double g = 0.375 * cd / (ratio - 1) * u_inf * u_inf / a;
+    dyn.external = spheres::settling_forces(1, a, ratio, box.volume(), g);
+    const double weight = -dyn.external.net_gravity.x();
+    u_sn = u_inf;
+    for (int it = 0; it < 100; ++it) {
+      const double re = u_sn * 2 * a / nu;
+      u_sn = weight / (6 * M_PI * nu * a * (1 + 0.15 * std::pow(re, 0.687)));
+    }
+    phi = s.volume() / box.volume();
+  }
+  // The sphere equations after the fluid step.
+  template <class Real>
+  void move(const immersed_boundary::ImmersedBoundary<Real>& ib) {
+    spheres::advance_velocities(s,
+                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
+                                 ib.internal_angular_momentum_change()},
+                                dyn);
+    spheres::advance_positions(s, box);
+  }
+  // Slip against the mean liquid velocity (zero total momentum).
+  double slip() const {
+    const double liquid = -phi * s.density_ratio * s.velocity[0].x() / (1 - phi);
+    return liquid - s.velocity[0].x();
+  }
+  spheres::SphereSet s;
+  spheres::PeriodicBox box;
+  spheres::SphereDynamicsSettings dyn;
+  double u_sn = 0, phi = 0;
+};
+
 // One sphere (a = 4 dx, rho_p/rho = 4) settling from rest at Re_inf = 12
 // (nu = 0.02, U_inf = 0.03) in periodic boxes 2W x W x W. Reference: the
 // Schiller-Naumann terminal velocity U_SN for the sphere's net weight
@@ -71,46 +114,24 @@ using spheres::Vec3;
 // chi_eq = 2a / V_box^(1/3) and 2 % the calibration accuracy. The
 // deviation from U_SN is printed for both box sizes (the box-size effect).
 double settling_velocity_ratio(int W) {
-  const double a = 4.0, nu = 0.02, ratio = 4.0, re_inf = 12.0;
+  const double a = 4.0, nu = 0.02, re_inf = 12.0;
   const double ag = test::calibrated_input_radius(a, nu);
   const int L = 2 * W;
   lattice::FluidLattice<float> fluid({L, W, W}, {nu, 0.25});
   immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
-  spheres::SphereSet s;
-  s.radius = a;
-  s.density_ratio = ratio;
-  s.resize(1);
-  s.position[0] = Vec3(0.75 * L + 0.3, 0.5 * W + 0.2, 0.5 * W - 0.1);
-  const spheres::PeriodicBox box{Vec3(L, W, W)};
-  const double u_inf = re_inf * nu / (2 * a);
-  const double cd = 24 / re_inf * (1 + 0.15 * std::pow(re_inf, 0.687));
-  const double g = 0.375 * cd / (ratio - 1) * u_inf * u_inf / a;  // SPEC section 2
-  spheres::SphereDynamicsSettings dyn;
-  dyn.external = spheres::settling_forces(1, a, ratio, box.volume(), g);
-  fluid.set_body_force({dyn.external.liquid_body_force.x(), 0, 0});
-  // Schiller-Naumann velocity for the actual net weight (rho_p - rho_bar) V g.
-  const double weight = -dyn.external.net_gravity.x();
-  double u_sn = u_inf;
-  for (int it = 0; it < 100; ++it) {
-    const double re = u_sn * 2 * a / nu;
-    u_sn = weight / (6 * M_PI * nu * a * (1 + 0.15 * std::pow(re, 0.687)));
-  }
-  const double phi = s.volume() / box.volume();
+  SettlingSphere sphere(a, nu, re_inf, re_inf * nu / (2 * a), L, W);
+  fluid.set_body_force({sphere.dyn.external.liquid_body_force.x(), 0, 0});
+  const double u_sn = sphere.u_sn;
+  const spheres::PeriodicBox& box = sphere.box;
   const int steps = 9000;  // ~70 a / U_inf
   double mean = 0;
   int count = 0;
   for (int step = 0; step < steps; ++step) {
-    ib.apply(fluid, s);
+    ib.apply(fluid, sphere.s);
     fluid.step();
-    spheres::advance_velocities(s,
-                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
-                                 ib.internal_angular_momentum_change()},
-                                dyn);
-    spheres::advance_positions(s, box);
+    sphere.move(ib);
     if (step >= steps - 2000) {
-      // Slip against the mean liquid velocity (zero total momentum).
-      const double liquid = -phi * ratio * s.velocity[0].x() / (1 - phi);
-      mean += liquid - s.velocity[0].x();
+      mean += sphere.slip();
       ++count;
     }
   }
@@ -142,47 +163,25 @@ TEST(SettlingSphere, SchillerNaumannAtRe12TwoBoxSizes) {
 // (Aitken, from t = t_end - 10, - 5, t_end in a/U_inf, where the increments
 // shrink geometrically; else the value at t_end).
 double sponge_settling_ratio(double re_inf, double W_over_a, double t_end) {
-  const double a = 6.0, ratio = 4.0, u_inf = 0.05;
+  const double a = 6.0, u_inf = 0.05;
   const double nu = 2 * a * u_inf / re_inf;
   const double ag = test::calibrated_input_radius(a, nu);
   const int L = static_cast<int>(16 * a), W = static_cast<int>(W_over_a * a);
   lattice::FluidLattice<float> fluid({L, W, W}, {nu, 0.25});
   immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
   test::WakeSponge<float> sponge(0.1, 8);
-  spheres::SphereSet s;
-  s.radius = a;
-  s.density_ratio = ratio;
-  s.resize(1);
-  s.position[0] = Vec3(0.75 * L + 0.3, 0.5 * W + 0.2, 0.5 * W - 0.1);
-  const spheres::PeriodicBox box{Vec3(L, W, W)};
-  const double cd = 24 / re_inf * (1 + 0.15 * std::pow(re_inf, 0.687));
-  const double g = 0.375 * cd / (ratio - 1) * u_inf * u_inf / a;  // SPEC section 2
-  spheres::SphereDynamicsSettings dyn;
-  dyn.external = spheres::settling_forces(1, a, ratio, box.volume(), g);
-  fluid.set_body_force({dyn.external.liquid_body_force.x(), 0, 0});
-  const double weight = -dyn.external.net_gravity.x();
-  double u_sn = u_inf;
-  for (int it = 0; it < 100; ++it) {
-    const double re = u_sn * 2 * a / nu;
-    u_sn = weight / (6 * M_PI * nu * a * (1 + 0.15 * std::pow(re, 0.687)));
-  }
-  const double phi = s.volume() / box.volume();
+  SettlingSphere sphere(a, nu, re_inf, u_inf, L, W);
+  fluid.set_body_force({sphere.dyn.external.liquid_body_force.x(), 0, 0});
+  const double u_sn = sphere.u_sn;
   const int every = static_cast<int>(std::lround(5 * a / u_inf));  // 5 a / U_inf
   const int steps = static_cast<int>(std::lround(t_end / 5)) * every;
   std::vector<double> series;
   for (int step = 1; step <= steps; ++step) {
-    ib.apply(fluid, s);
-    sponge.apply(fluid, s.position[0].x(), ag + 1.5);
+    ib.apply(fluid, sphere.s);
+    sponge.apply(fluid, sphere.s.position[0].x(), ag + 1.5);
     fluid.step();
-    spheres::advance_velocities(s,
-                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
-                                 ib.internal_angular_momentum_change()},
-                                dyn);
-    spheres::advance_positions(s, box);
-    if (step % every == 0) {
-      const double liquid = -phi * ratio * s.velocity[0].x() / (1 - phi);
-      series.push_back((liquid - s.velocity[0].x()) / u_sn);
-    }
+    sphere.move(ib);
+    if (step % every == 0) series.push_back(sphere.slip() / u_sn);
   }
   const std::size_t n = series.size();
   const double x0 = series[n - 3], x1 = series[n - 2], x2 = series[n - 1];
