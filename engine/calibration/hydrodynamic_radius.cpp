@@ -269,8 +269,8 @@ double CalibrationTable::input_radius(double hydrodynamic_radius, double viscosi
     if (e.viscosity >= viscosity && (!above || e.viscosity < above->viscosity)) above = &e;
   }
   if (!below || !above || below->viscosity == above->viscosity) return nearest.input_radius;
-  const double s = std::log(viscosity / below->viscosity) /
-                   std::log(above->viscosity / below->viscosity);
+  const double s =
+      std::log(viscosity / below->viscosity) / std::log(above->viscosity / below->viscosity);
   return below->input_radius + s * (above->input_radius - below->input_radius);
 }
 

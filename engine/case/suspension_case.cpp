@@ -292,6 +292,11 @@ nlohmann::json SuspensionCase::to_json() const {
 }
 
 nlohmann::json SuspensionCase::derived_json() const {
+  const std::string input_radius_from =
+      input_radius_given    ? std::string("numerics.input_radius")
+      : scene == "granular" ? std::string("unused (no liquid)")
+                            : "shipped calibration, interpolated in log nu (nearest entry nu = " +
+                                  format_value(calibration_viscosity) + ")";
   return {{"box_cells", {box.nx, box.ny, box.nz}},
           {"sphere_count", sphere_count},
           {"phi_realised", phi_realised},
@@ -307,12 +312,7 @@ nlohmann::json SuspensionCase::derived_json() const {
           {"sphere_net_gravity", sphere_net_gravity},
           {"Mach_U_inf", settling_velocity * std::sqrt(3.0)},
           {"input_radius", input_radius},
-          {"input_radius_from", input_radius_given    ? std::string("numerics.input_radius")
-                                : scene == "granular" ? std::string("unused (no liquid)")
-                                                      : "shipped calibration, interpolated in "
-                                                        "log nu (nearest entry nu = " +
-                                                            format_value(calibration_viscosity) +
-                                                            ")"}};
+          {"input_radius_from", input_radius_from}};
 }
 
 }  // namespace flocsim::cases

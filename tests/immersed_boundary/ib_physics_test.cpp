@@ -151,8 +151,9 @@ void creeping_settling(double a, int L, Vec3 start, int steps) {
     spheres::advance_positions(s, box);
     if (step >= steps / 2) mean += s.velocity[0].x() / (steps - steps / 2);
   }
-  std::printf("creeping settling a = %g, L = %d (chi = %.3f): u_p = %.6e, expected %.6e (error %+.2f %%)\n",
-              a, L, chi, mean, expected, 100 * (mean / expected - 1));
+  std::printf(
+      "creeping settling a = %g, L = %d (chi = %.3f): u_p = %.6e, expected %.6e (error %+.2f %%)\n",
+      a, L, chi, mean, expected, 100 * (mean / expected - 1));
   EXPECT_NEAR(mean / expected, 1.0, 0.02);
   EXPECT_LT(s.velocity[0].tail<2>().norm(), 1e-3 * std::abs(expected));
 }

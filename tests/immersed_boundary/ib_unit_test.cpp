@@ -173,7 +173,7 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
   EXPECT_NEAR(table.input_radius(6, 0.02), 5.58, 1e-12);
   // a quarter of the way: log(0.01 sqrt(2)) = log 0.01 + (1/4) log 4
   EXPECT_NEAR(table.input_radius(6, 0.01 * std::sqrt(2.0)), 5.575, 1e-12);
-  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.01), 5.57);   // at an entry: that entry
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.01), 5.57);  // at an entry: that entry
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.04), 5.59);
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.005), 5.57);  // outside: the nearest entry
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.5), 5.59);
