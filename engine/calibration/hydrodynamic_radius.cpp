@@ -233,12 +233,20 @@ CalibrationTable CalibrationTable::parse(const std::string& json_text, const std
   return t;
 }
 
+namespace {
+// An entry for this a made with this marker spacing and number of sweeps.
+bool same_scheme(const CalibrationEntry& e, double hydrodynamic_radius, double marker_spacing,
+                 int iterations) {
+  return std::abs(e.hydrodynamic_radius - hydrodynamic_radius) <= 1e-6 &&
+         std::abs(e.marker_spacing - marker_spacing) <= 1e-9 && e.iterations == iterations;
+}
+}  // namespace
+
 const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, double viscosity,
                                                  double marker_spacing, int iterations) const {
   const CalibrationEntry* best = nullptr;
   for (const auto& e : entries_) {
-    if (std::abs(e.hydrodynamic_radius - hydrodynamic_radius) > 1e-6) continue;
-    if (std::abs(e.marker_spacing - marker_spacing) > 1e-9 || e.iterations != iterations) continue;
+    if (!same_scheme(e, hydrodynamic_radius, marker_spacing, iterations)) continue;
     if (!best || std::abs(std::log(e.viscosity / viscosity)) <
                      std::abs(std::log(best->viscosity / viscosity)))
       best = &e;
@@ -263,8 +271,7 @@ double CalibrationTable::input_radius(double hydrodynamic_radius, double viscosi
       lookup(hydrodynamic_radius, viscosity, marker_spacing, iterations);
   const CalibrationEntry *below = nullptr, *above = nullptr;
   for (const auto& e : entries_) {
-    if (std::abs(e.hydrodynamic_radius - hydrodynamic_radius) > 1e-6) continue;
-    if (std::abs(e.marker_spacing - marker_spacing) > 1e-9 || e.iterations != iterations) continue;
+    if (!same_scheme(e, hydrodynamic_radius, marker_spacing, iterations)) continue;
     if (e.viscosity <= viscosity && (!below || e.viscosity > below->viscosity)) below = &e;
     if (e.viscosity >= viscosity && (!above || e.viscosity < above->viscosity)) above = &e;
   }
