@@ -202,13 +202,13 @@ double sponge_settling_ratio(double re_inf, double W_over_a, double t_end) {
 
 // The box-size effect with the wake removed: W = 12a and 16a (a 16a long box).
 // Reference: Schiller-Naumann. It fits the standard drag curve to about 5 %
-// (Clift, Grace & Weber 1978); here the standard curve's own correlation,
-// C_D = 24/Re (1 + 0.1935 Re^0.6305) for 20 < Re < 260, lies 4.6 % (Re = 23)
-// to 1.3 % (Re = 69) above it, i.e. an isolated sphere's velocity is 1-3 %
-// below U_SN. Asserted: U/U_SN in [0.94, 1.03] in the wider box (U_SN's 5 %
-// in drag, about 3.5 % in velocity, widened on the low side by the 3 % the
-// standard curve sits below U_SN), and the box effect converged: the wider box
-// within 1 % of the narrower one and not slower.
+// (Clift, Grace & Weber 1978); here the standard curve's own correlation
+// (their Table 5.2, as quoted from memory), C_D = 24/Re (1 + 0.1935 Re^0.6305)
+// for 20 < Re < 260, lies 4.6 % (Re = 23) to 1.1 % (Re = 70) above it, i.e. an
+// isolated sphere's velocity is 1-3 % below U_SN. Asserted: U/U_SN in [0.94, 1.03] in the wider box
+// (U_SN's 5 % in drag, about 3.5 % in velocity, widened on the low side by the 3 % the standard
+// curve sits below U_SN), and the box effect converged: the wider box within 1 % of the narrower
+// one and not slower.
 void sponge_settling_check(double re_inf, double t_end) {
   const double narrow = sponge_settling_ratio(re_inf, 12, t_end);
   const double wide = sponge_settling_ratio(re_inf, 16, t_end);
