@@ -182,6 +182,34 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
   EXPECT_THROW(table.input_radius(5, 0.02), std::out_of_range);
 }
 
+// The shipped table against its own records: every entry keeps the runs
+// that made it (box L, body force f, measured superficial velocity U). From
+// those the hydrodynamic radius is recomputed here by inverting the
+// Sangani-Acrivos series, K(2a/L) = f L^3 / (6 pi nu a U), and must be the
+// wanted a to 0.02 dx in every box (K to about 1 % at chi = 0.7), with the
+// runs made at the entry's a_g, and the offset a - a_g within SPEC's "typically
+// <= 0.5 dx" and positive (the kernel smears the surface outwards). It also
+// checks that a = 4, 6, 8 and 12 are all there, at nu = 1/6 at least.
+TEST(CalibrationTable, ShippedEntriesReproduceTheirRadiusFromTheirOwnRuns) {
+  const auto& table = calibration::CalibrationTable::shipped();
+  ASSERT_FALSE(table.entries().empty());
+  for (double a : {4.0, 6.0, 8.0, 12.0}) EXPECT_NO_THROW(table.lookup(a, 1.0 / 6.0)) << "a = " << a;
+  for (const auto& e : table.entries()) {
+    SCOPED_TRACE("a = " + std::to_string(e.hydrodynamic_radius) +
+                 ", nu = " + std::to_string(e.viscosity));
+    EXPECT_GT(e.hydrodynamic_radius - e.input_radius, 0.0);
+    EXPECT_LE(e.hydrodynamic_radius - e.input_radius, 0.5);
+    ASSERT_GE(e.checks.size(), 2u);
+    for (const auto& c : e.checks) {
+      EXPECT_DOUBLE_EQ(c.input_radius, e.input_radius);
+      const double force = c.body_force * c.box * c.box * c.box;
+      const double a = calibration::hydrodynamic_radius_from_drag(force, c.superficial_velocity,
+                                                                  e.viscosity, c.box);
+      EXPECT_NEAR(a, e.hydrodynamic_radius, 0.02) << "box " << c.box;
+    }
+  }
+}
+
 // The validation runs' wake sponge (wake_sponge.hpp): its forces sum to zero,
 // so a lattice with the sponge keeps the momentum of a twin without it; it
 // relaxes the slab's velocity towards the slab mean; and it takes back its old
