@@ -228,7 +228,7 @@ TEST(SettlingSphereWithWakeSponge, SchillerNaumannAtRe72) {
 // Resolution: the same Re_inf = 72 run (W = 12a) at a = 8 dx. The offset from
 // Schiller-Naumann must be a property of the flow, not of the grid: a = 8
 // within the same bounds as a = 6 and within 1 % of it (at Re_inf = 24 the two
-// differ by 0.2 %). About 35 minutes on 2 threads.
+// differ by 0.2 %). About 30 minutes on one thread.
 TEST(SettlingSphereWithWakeSponge, ResolutionAtRe72) {
   const double coarse = sponge_settling_ratio(72, 12, 60, 6.0);
   const double fine = sponge_settling_ratio(72, 12, 60, 8.0);
