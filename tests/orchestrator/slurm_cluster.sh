@@ -50,7 +50,12 @@ chown -R slurm:slurm "$prefix/state" "$prefix/log" "$prefix/run" || fail "no slu
 chmod 755 "$prefix" "$prefix/run" "$prefix/log"
 chown munge:munge "$prefix/munge"
 chmod 700 "$prefix/munge"
-cpus=$(nproc)
+# At least 2 CPUs, so that the tests' two array tasks run side by side
+# (config_overrides lets the node claim more than it has). Not `nproc`: it
+# answers OMP_NUM_THREADS, and OMP_NUM_THREADS=1 in the caller's environment
+# made the tasks queue one behind the other.
+cpus=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 1)
+[ "$cpus" -ge 2 ] 2>/dev/null || cpus=2
 cat >"$conf" <<EOF
 ClusterName=flocsimtest
 SlurmctldHost=localhost
