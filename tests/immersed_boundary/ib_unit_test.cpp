@@ -186,7 +186,7 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
 // that made it (box L, body force f, measured superficial velocity U). From
 // those the hydrodynamic radius is recomputed here by inverting the
 // Sangani-Acrivos series, K(2a/L) = f L^3 / (6 pi nu a U), and must be the
-// wanted a to 0.02 dx in every box (K to about 1 % at chi = 0.7), with the
+// wanted a to 0.02 dx in every box (0.5 % of a at a = 4), with the
 // runs made at the entry's a_g, and the offset a - a_g within SPEC's "typically
 // <= 0.5 dx" and positive (the kernel smears the surface outwards). It also
 // checks that a = 4, 6, 8 and 12 are all there, at nu = 1/6 at least.
