@@ -8,13 +8,11 @@
 
 namespace flocsim::test {
 
-// Input radius for hydrodynamic radius a from the shipped calibration table
-// (engine/calibration/hydrodynamic_radius.json), interpolated in log nu as the
-// solver does (CalibrationTable::input_radius).
+// Input radius for hydrodynamic radius a from the calibration table compiled
+// into the build (engine/calibration/hydrodynamic_radius.json), interpolated in
+// log nu: the very call the solver makes (suspension_case.cpp).
 inline double calibrated_input_radius(double a, double viscosity) {
-  static const calibration::CalibrationTable table =
-      calibration::CalibrationTable::load(FLOCSIM_CALIBRATION_TABLE);
-  return table.input_radius(a, viscosity);
+  return calibration::CalibrationTable::shipped().input_radius(a, viscosity);
 }
 
 }  // namespace flocsim::test
