@@ -252,17 +252,14 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
 }
 
 SweepSpec read_sweep_file(const std::string& filename) {
-  std::ifstream f(filename);
-  if (!f) throw InputError("sweep file " + filename + ": cannot be opened");
-  std::stringstream text;
-  text << f.rdbuf();
-  nlohmann::ordered_json file;
+  std::string text;
   try {
-    file = nlohmann::ordered_json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError("sweep file " + filename + ": not valid JSON: " + e.what());
+    text = flocsim::input::read_input_text(filename);
+  } catch (const InputError& e) {
+    throw InputError(std::string("sweep file ") + e.what());
   }
-  return parse_sweep(file, filename);
+  flocsim::input::check_json_text(text, "sweep file " + filename);
+  return parse_sweep(nlohmann::ordered_json::parse(text), filename);
 }
 
 std::vector<RunPoint> expand(const SweepSpec& sweep) {

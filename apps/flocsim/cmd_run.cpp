@@ -47,7 +47,11 @@ int run_command(const RunArguments& a) {
       }
     }
   } catch (const input::InputError& e) {
-    std::fprintf(stderr, "flocsim run: input error in %s: %s\n", a.case_file.c_str(), e.what());
+    // file-level refusals (read_json_file) already start with the file's name
+    const std::string what = e.what();
+    const bool named = what.rfind(a.case_file + ":", 0) == 0;
+    std::fprintf(stderr, "flocsim run: input error%s%s: %s\n", named ? "" : " in ",
+                 named ? "" : a.case_file.c_str(), what.c_str());
     return kExitBadInput;
   }
   run::install_stop_handlers();
@@ -87,7 +91,15 @@ const bool registered = register_command(
        cmd.add_flag("--quiet,-q", args->quiet, "Write only the log file, nothing on stderr");
        cmd.add_option("--stop-after", args->stop_after_steps,
                       "Stop after N steps as if SIGTERM arrived (checkpoint, exit 3); for tests")
-           ->check(CLI::NonNegativeNumber);
+           ->check(CLI::Validator(
+               [](std::string& v) -> std::string {
+                 // a whole number of steps; CLI11's own range check would print
+                 // the range of long (19 digits) or of double (309)
+                 const bool digits = !v.empty() && v.size() <= 18 &&
+                                     v.find_first_not_of("0123456789") == std::string::npos;
+                 return digits ? std::string() : "must be a whole number of steps >= 0, got " + v;
+               },
+               "STEPS"));
        return [args] { return run_command(*args); };
      }});
 

@@ -102,6 +102,9 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       throw InputError(
           "phi and positions_from: give one; with positions_from the snapshot sets N and phi");
     c.positions_from = root.text("positions_from");
+    if (c.positions_from.empty())
+      throw InputError(
+          "positions_from = \"\": must name a sphere snapshot file (spheres/step_N.h5 of a run)");
   }
   if (!single && c.positions_from.empty())
     c.phi = root.number("phi",
@@ -132,7 +135,10 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   const double a = c.radius_cells;
   if (has_nu) {
     c.viscosity = num.number(
-        "viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
+        "viscosity", {.at_least = kSmallestTestedViscosity,
+                      .at_most = 1,
+                      .why = "(tau = 3 nu + 1/2; below 0.005, tau = 0.515, the coupled solver is "
+                             "not tested stable)"});
     c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
   } else {
     const Range u_range{
@@ -155,15 +161,31 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
          .why = "(markers sit inside the hydrodynamic radius a_over_dx, by less than 1 dx)"});
   num.finish();
   if (c.settling_velocity > kMaxSettlingVelocity)
-    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) +
-                     " * " + format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
-                     format_value(c.settling_velocity) +
-                     ": must be <= " + format_value(kMaxSettlingVelocity) +
-                     " (Mach limit for settling flows); lower numerics.viscosity");
+    throw InputError(
+        "numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) + " * " +
+        format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
+        format_value(c.settling_velocity) + ": must be <= " + format_value(kMaxSettlingVelocity) +
+        " (Mach limit for settling flows); " +
+        (c.viscosity > kSmallestTestedViscosity
+             ? std::string("lower numerics.viscosity")
+             : "the smallest tested viscosity (" + format_value(kSmallestTestedViscosity) +
+                   ") allows Re_inf <= " +
+                   format_value(2 * a * kMaxSettlingVelocity / kSmallestTestedViscosity) +
+                   " at this a_over_dx; raise numerics.a_over_dx to at least " +
+                   format_value(std::ceil(c.reynolds_inf * kSmallestTestedViscosity /
+                                          (2 * kMaxSettlingVelocity))) +
+                   " or lower Re_inf"));
+  // Only reachable through an explicit U_inf: a given viscosity is range-checked
+  // above and the default U_inf is lowered to stay inside the range.
   if (c.viscosity < kSmallestTestedViscosity)
-    c.warnings.push_back("viscosity = " + format_value(c.viscosity) +
-                         " is below the smallest tested (" +
-                         format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
+    throw InputError(
+        "numerics.U_inf = " + format_value(c.settling_velocity) +
+        " with Re_inf = " + format_value(c.reynolds_inf) + " and a_over_dx = " + format_value(a) +
+        " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.viscosity) +
+        ": must be >= " + format_value(kSmallestTestedViscosity) +
+        " (tau = 0.515, the smallest the coupled solver is tested stable at); raise "
+        "numerics.U_inf to at least " +
+        format_value(kSmallestTestedViscosity * c.reynolds_inf / (2 * a)) + " or leave it out");
 
   if (c.scene != "granular" && !c.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)

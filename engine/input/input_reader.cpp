@@ -1,9 +1,13 @@
 #include "engine/input/input_reader.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <climits>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 namespace flocsim::input {
@@ -42,7 +46,7 @@ bool Range::contains(double v) const {
 InputReader::InputReader(const nlohmann::json& object, std::string path)
     : object_(object), path_(std::move(path)) {
   if (!object_.is_object())
-    throw InputError((path_.empty() ? std::string("input") : path_) + " = " + object_.dump() +
+    throw InputError((path_.empty() ? std::string("input") : path_) + " = " + shown(object_) +
                      ": must be a JSON object");
 }
 
@@ -64,7 +68,7 @@ double InputReader::number(const std::string& key, const Range& range,
     throw InputError(field(key) + " is missing: a number " + range.describe() + " is required");
   }
   if (!v->is_number())
-    throw InputError(field(key) + " = " + v->dump() + ": must be a number " + range.describe());
+    throw InputError(field(key) + " = " + shown(*v) + ": must be a number " + range.describe());
   const double x = v->get<double>();
   if (!range.contains(x))
     throw InputError(field(key) + " = " + format_number(x) + ": must be " + range.describe());
@@ -79,10 +83,10 @@ long InputReader::integer(const std::string& key, const Range& range,
     throw InputError(field(key) + " is missing: an integer " + range.describe() + " is required");
   }
   if (!v->is_number_integer())
-    throw InputError(field(key) + " = " + v->dump() + ": must be an integer " + range.describe());
+    throw InputError(field(key) + " = " + shown(*v) + ": must be an integer " + range.describe());
   // an unsigned value beyond the range of long would wrap: refuse it
   if (v->is_number_unsigned() && v->get<unsigned long>() > static_cast<unsigned long>(LONG_MAX))
-    throw InputError(field(key) + " = " + v->dump() + ": must be " + range.describe());
+    throw InputError(field(key) + " = " + shown(*v) + ": must be " + range.describe());
   const long x = v->get<long>();
   if (!range.contains(static_cast<double>(x)))
     throw InputError(field(key) + " = " + std::to_string(x) + ": must be " + range.describe());
@@ -96,7 +100,7 @@ bool InputReader::boolean(const std::string& key, std::optional<bool> fallback) 
     throw InputError(field(key) + " is missing: true or false is required");
   }
   if (!v->is_boolean())
-    throw InputError(field(key) + " = " + v->dump() + ": must be true or false");
+    throw InputError(field(key) + " = " + shown(*v) + ": must be true or false");
   return v->get<bool>();
 }
 
@@ -106,7 +110,7 @@ std::string InputReader::text(const std::string& key, std::optional<std::string>
     if (fallback) return *fallback;
     throw InputError(field(key) + " is missing: a string is required");
   }
-  if (!v->is_string()) throw InputError(field(key) + " = " + v->dump() + ": must be a string");
+  if (!v->is_string()) throw InputError(field(key) + " = " + shown(*v) + ": must be a string");
   return v->get<std::string>();
 }
 
@@ -122,7 +126,7 @@ std::string InputReader::choice(const std::string& key, const std::vector<std::s
   }
   if (!v->is_string() ||
       std::find(allowed.begin(), allowed.end(), v->get<std::string>()) == allowed.end())
-    throw InputError(field(key) + " = " + v->dump() + ": must be one of " + list);
+    throw InputError(field(key) + " = " + shown(*v) + ": must be one of " + list);
   return v->get<std::string>();
 }
 
@@ -136,14 +140,14 @@ std::vector<double> InputReader::numbers(const std::string& key, std::size_t len
                      " numbers is required");
   }
   if (!v->is_array() || v->size() != length)
-    throw InputError(field(key) + " = " + v->dump() + ": must be an array of " +
+    throw InputError(field(key) + " = " + shown(*v) + ": must be an array of " +
                      std::to_string(length) + " numbers");
   std::vector<double> out;
   for (std::size_t i = 0; i < length; ++i) {
     const auto& e = (*v)[i];
     const std::string name = field(key) + "[" + std::to_string(i) + "]";
     if (!e.is_number())
-      throw InputError(name + " = " + e.dump() + ": must be a number " + range.describe());
+      throw InputError(name + " = " + shown(e) + ": must be a number " + range.describe());
     const double x = e.get<double>();
     if (!range.contains(x))
       throw InputError(name + " = " + format_number(x) + ": must be " + range.describe());
@@ -158,7 +162,7 @@ InputReader InputReader::object(const std::string& key, bool required) {
     if (required) throw InputError(field(key) + " is missing: an object is required");
     return InputReader(nlohmann::json::object(), field(key));
   }
-  if (!v->is_object()) throw InputError(field(key) + " = " + v->dump() + ": must be a JSON object");
+  if (!v->is_object()) throw InputError(field(key) + " = " + shown(*v) + ": must be a JSON object");
   return InputReader(*v, field(key));
 }
 
@@ -174,14 +178,151 @@ void InputReader::finish() const {
   }
 }
 
-nlohmann::json read_json_file(const std::string& filename) {
-  std::ifstream in(filename);
-  if (!in) throw InputError(filename + ": cannot open file");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(filename + ": not valid JSON: " + e.what());
+namespace {
+
+// The SAX pass of check_json_text: follows the path of the value being read
+// (for messages) and stops at the first problem, which it keeps in `error`.
+class JsonChecker {
+ public:
+  explicit JsonChecker(const std::string& text) : text_(text) {}
+  std::string error;
+
+  bool null() { return value(); }
+  bool boolean(bool) { return value(); }
+  bool number_integer(std::int64_t) { return value(); }
+  bool number_unsigned(std::uint64_t) { return value(); }
+  bool number_float(double, const std::string&) { return value(); }
+  bool string(std::string&) { return value(); }
+  bool binary(nlohmann::json::binary_t&) { return value(); }
+  bool start_object(std::size_t) { return open(true); }
+  bool start_array(std::size_t) { return open(false); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+  bool key(std::string& k) {
+    Frame& f = frames_.back();
+    f.key = k;
+    f.has_key = true;
+    if (!f.keys.insert(k).second) {
+      error = path() +
+              ": key given twice in one object (a JSON reader would silently keep one "
+              "of the two values); remove one";
+      return false;
+    }
+    return true;
   }
+  bool parse_error(std::size_t position, const std::string& token,
+                   const nlohmann::detail::exception& e) {
+    const std::string where = frames_.empty() ? std::string() : " (in " + path() + ")";
+    if (e.id == 406)  // out_of_range.406: a number beyond double
+      error = (frames_.empty() ? std::string("value") : path()) + " = " + token.substr(0, 40) +
+              ": a number beyond the range of double (line " + std::to_string(line_of(position)) +
+              ")";
+    else
+      error = std::string("not valid JSON: ") + without_prefix(e.what()) + where;
+    return false;
+  }
+
+ private:
+  struct Frame {
+    bool object = false;
+    bool has_key = false;
+    std::string key;
+    std::set<std::string> keys;
+    std::size_t count = 0;  // elements completed (arrays)
+  };
+
+  bool value() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().count;
+    return true;
+  }
+  bool open(bool object) {
+    if (static_cast<int>(frames_.size()) >= kMaxInputDepth) {
+      error = (frames_.empty() ? std::string("document") : path()) + ": nested deeper than " +
+              std::to_string(kMaxInputDepth) + " levels; case and sweep files need about five";
+      return false;
+    }
+    frames_.push_back({object, false, {}, {}, 0});
+    return true;
+  }
+  bool close() {
+    frames_.pop_back();
+    return value();
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) {
+      if (f.object) {
+        if (f.has_key) p += (p.empty() ? "" : ".") + f.key;
+      } else {
+        p += "[" + std::to_string(f.count) + "]";
+      }
+    }
+    if (p.empty()) return "top level";
+    // a path into deep nesting is cut: its start says where it is
+    return p.size() > 80 ? p.substr(0, 80) + "..." : p;
+  }
+  std::size_t line_of(std::size_t position) const {
+    const std::size_t end = std::min(position, text_.size());
+    return 1 + static_cast<std::size_t>(std::count(text_.begin(), text_.begin() + end, '\n'));
+  }
+  static std::string without_prefix(const std::string& what) {
+    // "[json.exception.parse_error.101] parse error at ..." -> "parse error at ..."
+    const auto close = what.find("] ");
+    return what.rfind("[json.exception.", 0) == 0 && close != std::string::npos
+               ? what.substr(close + 2)
+               : what;
+  }
+
+  const std::string& text_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
+std::string read_input_text(const std::string& filename) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(filename, ec);
+  if (ec || !fs::exists(st)) throw InputError(filename + ": cannot be opened: no such file");
+  if (fs::is_directory(st)) throw InputError(filename + ": is a directory, not a JSON file");
+  const std::uintmax_t bytes = fs::file_size(filename, ec);
+  if (!ec && bytes > kMaxInputFileBytes)
+    throw InputError(filename + ": " + std::to_string(bytes) + " bytes; input files are at most " +
+                     std::to_string(kMaxInputFileBytes >> 20) +
+                     " MiB (a case or sweep is a few kB; sphere positions belong in a "
+                     "snapshot given by positions_from)");
+  std::ifstream in(filename, std::ios::binary);
+  if (!in) throw InputError(filename + ": cannot open file (" + std::strerror(errno) + ")");
+  std::string text;
+  // read one byte past the limit so that a file that grew meanwhile is still refused
+  text.resize(static_cast<std::size_t>(kMaxInputFileBytes) + 1);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) throw InputError(filename + ": cannot read file");
+  if (text.size() > kMaxInputFileBytes)
+    throw InputError(filename + ": larger than " + std::to_string(kMaxInputFileBytes >> 20) +
+                     " MiB; input files are small");
+  return text;
+}
+
+void check_json_text(const std::string& text, const std::string& origin) {
+  JsonChecker checker(text);
+  if (!nlohmann::json::sax_parse(text, &checker)) {
+    if (checker.error.empty()) checker.error = "not valid JSON";
+    throw InputError(origin + ": " + checker.error);
+  }
+}
+
+nlohmann::json read_json_file(const std::string& filename) {
+  const std::string text = read_input_text(filename);
+  check_json_text(text, filename);
+  return nlohmann::json::parse(text);
+}
+
+std::string shown(const nlohmann::json& value, std::size_t limit) {
+  const std::string text = value.dump();
+  if (text.size() <= limit) return text;
+  return text.substr(0, limit) + "... (" + std::to_string(text.size()) + " characters)";
 }
 
 }  // namespace flocsim::input

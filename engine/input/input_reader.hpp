@@ -7,6 +7,7 @@
 //   InputReader in(json, "case");
 //   double nu = in.number("viscosity", {.above = 0, .at_most = 1}, 0.01);
 //   in.finish();   // throws if the object had keys nobody asked for
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -64,7 +65,28 @@ class InputReader {
   std::vector<std::string> known_;
 };
 
-// Reads a JSON file; parse errors become InputErrors naming file and position.
+// Input files are small (a case or a sweep is a few kB; sphere positions come
+// from HDF5 snapshots, not JSON): anything larger is refused before it is read.
+inline constexpr std::uintmax_t kMaxInputFileBytes = 4u << 20;
+// Case and sweep files nest four or five levels; the limit keeps every later
+// recursive walk of the document (copy, dump, destruction) far from the stack's end.
+inline constexpr int kMaxInputDepth = 64;
+
+// The text of an input file, refused with an InputError naming the file when
+// it is missing, a directory, unreadable or larger than kMaxInputFileBytes.
+std::string read_input_text(const std::string& filename);
+
+// Checks JSON text without building a document (an iterative SAX pass, so
+// that no input can exhaust the stack) and throws an InputError naming
+// `origin`, the field's path and the line for: a syntax error, a number
+// beyond the range of double, nesting deeper than kMaxInputDepth, or a key
+// given twice in one object (JSON parsers would silently keep the last).
+void check_json_text(const std::string& text, const std::string& origin);
+
+// Reads a JSON file through read_input_text and check_json_text.
 nlohmann::json read_json_file(const std::string& filename);
+
+// A JSON value as shown in a message: its text, cut to `limit` characters.
+std::string shown(const nlohmann::json& value, std::size_t limit = 80);
 
 }  // namespace flocsim::input
