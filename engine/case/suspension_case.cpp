@@ -79,6 +79,10 @@ std::vector<double> snapshot_positions(const std::string& file, double a,
 
 }  // namespace
 
+double smallest_stable_viscosity(double radius_cells) {
+  return radius_cells >= 6 ? kSmallestTestedViscosity : 2 * kSmallestTestedViscosity;
+}
+
 double schiller_naumann_drag_coefficient(double reynolds) {
   return 24.0 / reynolds * (1.0 + 0.15 * std::pow(reynolds, 0.687));
 }
@@ -133,21 +137,22 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
         "numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the "
         "other through Re_inf)");
   const double a = c.radius_cells;
+  const double nu_min = smallest_stable_viscosity(a);
+  const std::string stable_why =
+      "(the smallest viscosity the coupled solver is measured stable at "
+      "with a_over_dx = " +
+      format_value(a) + "; docs/numerics.md)";
   if (has_nu) {
-    c.viscosity = num.number(
-        "viscosity", {.at_least = kSmallestTestedViscosity,
-                      .at_most = 1,
-                      .why = "(tau = 3 nu + 1/2; below 0.005, tau = 0.515, the coupled solver is "
-                             "not tested stable)"});
+    c.viscosity = num.number("viscosity", {.at_least = nu_min, .at_most = 1, .why = stable_why});
     c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
   } else {
     const Range u_range{
         .above = 0, .at_most = kMaxSettlingVelocity, .why = "(Mach limit for settling flows)"};
     c.settling_velocity = num.number("U_inf", u_range, kDefaultSettlingVelocity);
     c.viscosity = c.settling_velocity * 2 * a / c.reynolds_inf;
-    // by default stay inside the tested viscosity range: lower U_inf instead
-    if (!has_u && c.viscosity < kSmallestTestedViscosity) {
-      c.viscosity = kSmallestTestedViscosity;
+    // by default stay inside the stable viscosity range: raise U_inf instead
+    if (!has_u && c.viscosity < nu_min) {
+      c.viscosity = nu_min;
       c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
     }
   }
@@ -160,32 +165,47 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
          .at_most = a,
          .why = "(markers sit inside the hydrodynamic radius a_over_dx, by less than 1 dx)"});
   num.finish();
-  if (c.settling_velocity > kMaxSettlingVelocity)
-    throw InputError(
-        "numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) + " * " +
-        format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
-        format_value(c.settling_velocity) + ": must be <= " + format_value(kMaxSettlingVelocity) +
-        " (Mach limit for settling flows); " +
-        (c.viscosity > kSmallestTestedViscosity
-             ? std::string("lower numerics.viscosity")
-             : "the smallest tested viscosity (" + format_value(kSmallestTestedViscosity) +
-                   ") allows Re_inf <= " +
-                   format_value(2 * a * kMaxSettlingVelocity / kSmallestTestedViscosity) +
-                   " at this a_over_dx; raise numerics.a_over_dx to at least " +
-                   format_value(std::ceil(c.reynolds_inf * kSmallestTestedViscosity /
-                                          (2 * kMaxSettlingVelocity))) +
-                   " or lower Re_inf"));
+  // Re_inf = 2 a U_inf / nu: with U_inf at the Mach limit and nu at the
+  // stability floor the largest Re_inf grows with a. Where this Re_inf is out
+  // of reach at this a, say so and name the smallest a that reaches it.
+  const double largest_re = 2 * a * kMaxSettlingVelocity / nu_min;
+  auto beyond_reach = [&] {
+    double needed = 24;                              // the largest a_over_dx accepted
+    for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
+      if (calibrated > a &&
+          2 * calibrated * kMaxSettlingVelocity / smallest_stable_viscosity(calibrated) >=
+              c.reynolds_inf) {
+        needed = calibrated;
+        break;
+      }
+    return "at a_over_dx = " + format_value(a) +
+           " the stability floor nu >= " + format_value(nu_min) +
+           " and the Mach limit U_inf <= " + format_value(kMaxSettlingVelocity) +
+           " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) +
+           "; raise numerics.a_over_dx to at least " + format_value(needed) +
+           (a < 6 && needed <= 6 ? " (fidelity standard or paper)" : "") + " or lower Re_inf";
+  };
+  if (c.settling_velocity > kMaxSettlingVelocity) {
+    const std::string way_out =
+        c.viscosity <= nu_min ? beyond_reach() : std::string("lower numerics.viscosity");
+    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) +
+                     " * " + format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
+                     format_value(c.settling_velocity) +
+                     ": must be <= " + format_value(kMaxSettlingVelocity) +
+                     " (Mach limit for settling flows); " + way_out);
+  }
   // Only reachable through an explicit U_inf: a given viscosity is range-checked
-  // above and the default U_inf is lowered to stay inside the range.
-  if (c.viscosity < kSmallestTestedViscosity)
+  // above and the default U_inf is raised to stay inside the range.
+  if (c.viscosity < nu_min)
     throw InputError(
         "numerics.U_inf = " + format_value(c.settling_velocity) +
         " with Re_inf = " + format_value(c.reynolds_inf) + " and a_over_dx = " + format_value(a) +
         " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.viscosity) +
-        ": must be >= " + format_value(kSmallestTestedViscosity) +
-        " (tau = 0.515, the smallest the coupled solver is tested stable at); raise "
-        "numerics.U_inf to at least " +
-        format_value(kSmallestTestedViscosity * c.reynolds_inf / (2 * a)) + " or leave it out");
+        ": must be >= " + format_value(nu_min) + " " + stable_why + "; " +
+        (c.reynolds_inf > largest_re
+             ? beyond_reach()
+             : "raise numerics.U_inf to at least " +
+                   format_value(nu_min * c.reynolds_inf / (2 * a)) + " or leave it out"));
 
   if (c.scene != "granular" && !c.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)

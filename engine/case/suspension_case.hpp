@@ -26,6 +26,14 @@ inline constexpr double kMaxSettlingVelocity = 0.05;
 // middle of the paper's range (0.01-0.03).
 inline constexpr double kDefaultSettlingVelocity = 0.02;
 
+// Smallest viscosity at which the coupled solver (lattice, immersed boundary,
+// spheres) is measured stable at a resolution of a_over_dx cells per radius:
+// 0.005 (tau = 0.515) from a = 6 dx up, 0.01 below (docs/numerics.md,
+// "Stability floor": at a = 4, 21 of 25 suspensions at nu = 0.005-0.008
+// blew up within 20 a/U_inf, none of 6 at nu = 0.01; at a = 6 and 8, none of
+// 7 at nu = 0.005).
+double smallest_stable_viscosity(double radius_cells);
+
 struct SuspensionCase {
   std::string scene = "suspension";
   std::string fidelity = "standard";
