@@ -4,7 +4,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <utility>
 
@@ -186,12 +188,39 @@ class ResultsDb::Statement {
   sqlite3_stmt* stmt_ = nullptr;
 };
 
+namespace {
+
+// An existing file that does not start with SQLite's 16-byte header is not a
+// database; say so before SQLite answers with a bare "file is not a database".
+void refuse_non_sqlite_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return;
+  if (fs::is_directory(path, ec))
+    throw DbError(path + ": is a directory; --db must name a results database file");
+  if (fs::file_size(path, ec) == 0 || ec) return;  // an empty file becomes a new database
+  char header[16] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(header, sizeof header);
+  if (in.gcount() < 16 || std::memcmp(header, "SQLite format 3", 16) != 0)
+    throw DbError(path +
+                  ": not an SQLite database (it does not start with the SQLite header); "
+                  "--db must name a results database written by `flocsim sweep launch`");
+}
+
+}  // namespace
+
 ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pid_(getpid()) {
+  refuse_non_sqlite_file(path);
   if (mode == Mode::kCreate) {
     // a new database may live in a folder that does not exist yet (runs/x.sqlite)
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  }
+  if (mode == Mode::kReadOnly) {
+    open_read_only();
+    return;
   }
   const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX |
                     (mode == Mode::kCreate ? SQLITE_OPEN_CREATE : 0);
@@ -203,6 +232,15 @@ ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pi
     throw DbError(
         "cannot open results database " + path + ": " + why +
         (mode == Mode::kExisting ? " (does it exist? `flocsim sweep launch` creates it)" : ""));
+  }
+  const std::string read_only_message =
+      "results database " + path +
+      " is read-only (file permissions or a read-only file system), and this command writes to "
+      "it; `flocsim query` and `flocsim sweep status` can still read it";
+  if (sqlite3_db_readonly(db_, "main") == 1) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw ReadOnlyDbError(read_only_message);
   }
   sqlite3_busy_timeout(db_, kBusyTimeoutMs);
   try {
@@ -217,10 +255,60 @@ ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pi
     }
     exec("PRAGMA synchronous = NORMAL");
     create_or_migrate();
-  } catch (...) {
+  } catch (const DbError& e) {
+    const int code = sqlite3_errcode(db_);
     sqlite3_close(db_);
     db_ = nullptr;
-    throw;
+    // a writable file in a read-only folder: WAL cannot make its -wal file
+    if (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
+      throw ReadOnlyDbError(read_only_message);
+    throw DbError(std::string(e.what()).find(path) == std::string::npos
+                      ? "results database " + path + ": " + e.what()
+                      : std::string(e.what()));
+  }
+}
+
+// Read-only: no WAL switch, no migration. A WAL database in a folder where
+// the -shm index cannot be made is read as immutable when it has no -wal
+// content (nothing to miss); otherwise the reader must be able to make it.
+void ResultsDb::open_read_only() {
+  auto open = [&](const std::string& name, int extra) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    const int rc = sqlite3_open_v2(name.c_str(), &db_,
+                                   SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX | extra, nullptr);
+    if (rc != SQLITE_OK) return false;
+    sqlite3_busy_timeout(db_, kBusyTimeoutMs);
+    return sqlite3_exec(db_, "SELECT count(*) FROM sqlite_master", nullptr, nullptr, nullptr) ==
+           SQLITE_OK;
+  };
+  if (!std::filesystem::exists(path_)) {
+    throw DbError("cannot open results database " + path_ +
+                  ": no such file (does it exist? `flocsim sweep launch` creates it)");
+  }
+  bool ok = open(path_, 0);
+  if (!ok) {
+    std::error_code ec;
+    const auto wal = std::filesystem::file_size(path_ + "-wal", ec);
+    if (ec || wal == 0) ok = open("file:" + path_ + "?immutable=1", SQLITE_OPEN_URI);
+  }
+  if (!ok) {
+    const std::string why = db_ ? sqlite3_errmsg(db_) : "cannot open";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw DbError("cannot read results database " + path_ + ": " + why);
+  }
+  const int found = schema_version();
+  if (found != kSchemaVersion) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    // a database `sweep launch` has only just created holds no schema yet
+    throw DbError(found == 0
+                      ? path_ +
+                            ": holds no flocsim results (does it exist? `flocsim sweep "
+                            "launch` creates it)"
+                      : path_ + " has schema version " + std::to_string(found) +
+                            ", this flocsim reads version " + std::to_string(kSchemaVersion));
   }
 }
 

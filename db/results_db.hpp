@@ -26,6 +26,13 @@ class DbError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A writer opened a database it may not write (a read-only file, folder or
+// file system). Readers open such a database with Mode::kReadOnly.
+class ReadOnlyDbError : public DbError {
+ public:
+  using DbError::DbError;
+};
+
 inline constexpr int kSchemaVersion = 1;
 
 // Run states. A run is `pending` until first started, `running` while an
@@ -123,8 +130,13 @@ struct StateCount {
 
 class ResultsDb {
  public:
-  enum class Mode { kCreate, kExisting };
+  // kCreate and kExisting open for writing (kCreate makes a missing file);
+  // kReadOnly only reads, also from a read-only file or file system, and
+  // never changes the file (no WAL switch, no migration).
+  enum class Mode { kCreate, kExisting, kReadOnly };
   // Opens (and creates or migrates, when writable) the database at `path`.
+  // A file that is not an SQLite database, or a writer's read-only file, is
+  // refused with a DbError (ReadOnlyDbError) naming the path.
   ResultsDb(const std::string& path, Mode mode);
   ~ResultsDb();
   ResultsDb(const ResultsDb&) = delete;
@@ -203,6 +215,7 @@ class ResultsDb {
   template <class F>
   auto write(F&& body);
   void create_or_migrate();
+  void open_read_only();
 
   std::string path_;
   sqlite3* db_ = nullptr;

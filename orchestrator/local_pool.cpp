@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,12 +14,14 @@
 #include <set>
 #include <thread>
 
+#include "engine/input/input_reader.hpp"
 #include "orchestrator/process.hpp"
 
 namespace flocsim::orchestrator {
 
 namespace fs = std::filesystem;
 using db::unix_now;
+using nlohmann::json;
 
 std::atomic<int> g_stop_requests{0};
 
@@ -43,7 +46,63 @@ std::string default_runs_dir(const std::string& db_path) {
   return p.string();
 }
 
+namespace {
+
+// The first dotted path at which two JSON values differ ("" when equal).
+std::string first_difference(const json& a, const json& b, const std::string& path = "") {
+  if (a.is_object() && b.is_object()) {
+    for (auto it = a.begin(); it != a.end(); ++it) {
+      const std::string sub = path.empty() ? it.key() : path + "." + it.key();
+      if (!b.contains(it.key())) return sub;
+      const std::string d = first_difference(it.value(), b[it.key()], sub);
+      if (!d.empty()) return d;
+    }
+    for (auto it = b.begin(); it != b.end(); ++it)
+      if (!a.contains(it.key())) return path.empty() ? it.key() : path + "." + it.key();
+    return "";
+  }
+  return canonical(a) == canonical(b) ? "" : (path.empty() ? std::string("(top level)") : path);
+}
+
+// A sweep may grow (more axis values) or change how it runs (description,
+// retries, Slurm), but a relaunch under the same name with another base or
+// other axes would merge two different grids into one sweep: refuse it.
+void refuse_changed_grid(const db::SweepRecord& known, const SweepSpec& spec,
+                         const std::string& db_path) {
+  const SweepSpec before = parse_sweep(nlohmann::ordered_json::parse(known.spec_json), db_path);
+  const std::string changed = first_difference(before.base, spec.base);
+  if (!changed.empty()) {
+    const auto was = get_path(before.base, changed), now = get_path(spec.base, changed);
+    throw flocsim::input::InputError(
+        "sweep " + spec.name + " in " + db_path + " was launched with base." + changed + " = " +
+        (was ? flocsim::input::shown(*was) : std::string("(absent)")) + "; this file has " +
+        (now ? flocsim::input::shown(*now) : std::string("(absent)")) +
+        ". A sweep's base cannot change (its runs would mix two grids): give the new grid "
+        "another \"name\"");
+  }
+  std::vector<std::string> old_axes, new_axes;
+  for (const Axis& a : before.axes) old_axes.push_back(a.path);
+  for (const Axis& a : spec.axes) new_axes.push_back(a.path);
+  std::sort(old_axes.begin(), old_axes.end());
+  std::sort(new_axes.begin(), new_axes.end());
+  if (old_axes != new_axes) {
+    auto list = [](const std::vector<std::string>& v) {
+      std::string out;
+      for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
+      return out;
+    };
+    throw flocsim::input::InputError(
+        "sweep " + spec.name + " in " + db_path + " was launched with the axes " + list(old_axes) +
+        "; this file has " + list(new_axes) +
+        ". A sweep may add values to its axes but not change them: give the new grid another "
+        "\"name\"");
+  }
+}
+
+}  // namespace
+
 Registered register_sweep(db::ResultsDb& db, const SweepSpec& spec, const std::string& runs_dir) {
+  if (const auto known = db.find_sweep(spec.name)) refuse_changed_grid(*known, spec, db.path());
   const std::vector<RunPoint> points = expand(spec);
   nlohmann::json axes = nlohmann::json::array();
   for (const Axis& a : spec.axes) axes.push_back(a.path);

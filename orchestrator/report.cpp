@@ -181,6 +181,21 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
                        f.field + "\" (columns: " + cols + "; or a dotted case path)");
     }
   }
+  // A numeric field against a value that is not a number would compare as
+  // text (every row "matches" 'nu<abc'): refuse it.
+  for (const Filter& f : o.where) {
+    double number = 0;
+    if (as_number(json(f.value), number)) continue;
+    for (std::size_t i = 0; i < t.rows.size(); ++i) {
+      auto it = t.rows[i].find(f.field);
+      const json v =
+          it != t.rows[i].end() ? it->second : get_path(cases[i], f.field).value_or(json());
+      if (v.is_number())
+        throw InputError("--where " + f.field + f.op + f.value + ": " + f.field +
+                         " is a number, \"" + f.value +
+                         "\" is not; give a number (e.g. 0.02 or 2e-2)");
+    }
+  }
   std::vector<std::size_t> keep;
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     bool ok = true;

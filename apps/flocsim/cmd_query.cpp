@@ -40,7 +40,7 @@ const bool registered = register_command(
            q.format = o->format;
            q.columns = o->columns;
            for (const std::string& w : o->where) q.where.push_back(orc::parse_filter(w));
-           db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+           db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kReadOnly);  // only reads
            orc::write_query(db, q, std::cout);
            return kExitOk;
          } catch (const flocsim::input::InputError& e) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
@@ -172,6 +173,7 @@ const bool registered = register_command(
          try {
            if (*action == "launch") {
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
+             orc::expand(spec);  // a grid refused here leaves no database file behind
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const std::string runs_dir =
@@ -190,8 +192,19 @@ const bool registered = register_command(
              return run_sweep(*o, db, sweep, {"pending", "interrupted", "lost", "failed"});
            }
            if (*action == "status") {
-             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
-             orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
+             // status only reads, but where it may write it also marks workers
+             // found dead as lost; a read-only database is read as it is
+             std::unique_ptr<db::ResultsDb> opened;
+             try {
+               opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kExisting);
+               orc::reconcile_lost_workers(*opened, o->lease_s, &std::cout);
+             } catch (const db::ReadOnlyDbError&) {
+               opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
+               std::cout << o->db_path
+                         << " is read-only: shown as recorded (workers that died are not "
+                            "marked lost)\n";
+             }
+             db::ResultsDb& db = *opened;
              orc::write_status(
                  db,
                  o->sweep_name.empty() ? std::nullopt : std::optional<std::string>(o->sweep_name),

@@ -34,6 +34,32 @@ struct Handle {
   }
 };
 
+// The operating system's reason behind the HDF5 error on the stack, such as
+// "No space left on device", which HDF5's file driver records in the text of
+// its error entry ("..., errno = 28, error message = 'No space left on device', ...").
+std::string system_cause() {
+  std::string cause;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_DOWNWARD,
+      [](unsigned, const H5E_error2_t* e, void* out) -> herr_t {
+        const std::string desc = e && e->desc ? e->desc : "";
+        const std::string key = "error message = '";
+        const auto at = desc.find(key);
+        if (at == std::string::npos) return 0;
+        const auto end = desc.find('\'', at + key.size());
+        *static_cast<std::string*>(out) = desc.substr(at + key.size(), end - at - key.size());
+        return 1;  // the first system error is the cause
+      },
+      &cause);
+  H5Eclear2(H5E_DEFAULT);
+  return cause;
+}
+
+[[noreturn]] void fail(const std::string& what) {
+  const std::string cause = system_cause();
+  throw std::runtime_error(cause.empty() ? what : what + ": " + cause);
+}
+
 }  // namespace
 
 Hdf5File::Hdf5File(const std::filesystem::path& path, Mode mode) : path_(path) {
@@ -49,7 +75,7 @@ Hdf5File::Hdf5File(const std::filesystem::path& path, Mode mode) : path_(path) {
       file_ = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
       break;
   }
-  if (file_ < 0) throw std::runtime_error("cannot open HDF5 file " + path.string());
+  if (file_ < 0) fail("cannot open HDF5 file " + path.string());
 }
 
 Hdf5File::~Hdf5File() {
@@ -61,13 +87,12 @@ void Hdf5File::close() {
   const herr_t flushed = H5Fflush(file_, H5F_SCOPE_LOCAL);
   const herr_t closed = H5Fclose(file_);
   file_ = -1;
-  if (flushed < 0 || closed < 0)
-    throw std::runtime_error("cannot complete HDF5 file " + path_.string());
+  if (flushed < 0 || closed < 0) fail("cannot complete HDF5 file " + path_.string());
 }
 
 void Hdf5File::create_group(const std::string& name) {
   Handle g{H5Gcreate2(file_, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-  if (g.id < 0) throw std::runtime_error(path_.string() + ": cannot create group " + name);
+  if (g.id < 0) fail(path_.string() + ": cannot create group " + name);
 }
 
 bool Hdf5File::exists(const std::string& name) const {
@@ -76,7 +101,7 @@ bool Hdf5File::exists(const std::string& name) const {
 
 void Hdf5File::remove(const std::string& name) {
   if (H5Ldelete(file_, name.c_str(), H5P_DEFAULT) < 0)
-    throw std::runtime_error(path_.string() + ": cannot remove " + name);
+    fail(path_.string() + ": cannot remove " + name);
 }
 
 template <class T>
@@ -85,15 +110,15 @@ void Hdf5File::write(const std::string& name, const std::vector<hsize_t>& shape,
   Handle set{H5Dcreate2(file_, name.c_str(), memory_type<T>(), space.id, H5P_DEFAULT, H5P_DEFAULT,
                         H5P_DEFAULT),
              H5Dclose};
-  if (set.id < 0) throw std::runtime_error(path_.string() + ": cannot create dataset " + name);
+  if (set.id < 0) fail(path_.string() + ": cannot create dataset " + name);
   if (H5Dwrite(set.id, memory_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
-    throw std::runtime_error(path_.string() + ": cannot write dataset " + name);
+    fail(path_.string() + ": cannot write dataset " + name);
 }
 
 template <class T>
 std::vector<T> Hdf5File::read(const std::string& name, std::vector<hsize_t>* shape) const {
   Handle set{H5Dopen2(file_, name.c_str(), H5P_DEFAULT), H5Dclose};
-  if (set.id < 0) throw std::runtime_error(path_.string() + ": no dataset " + name);
+  if (set.id < 0) fail(path_.string() + ": no dataset " + name);
   Handle space{H5Dget_space(set.id), H5Sclose};
   const int rank = H5Sget_simple_extent_ndims(space.id);
   std::vector<hsize_t> dims(static_cast<std::size_t>(std::max(rank, 0)));
@@ -102,7 +127,7 @@ std::vector<T> Hdf5File::read(const std::string& name, std::vector<hsize_t>* sha
   for (hsize_t d : dims) n *= d;
   std::vector<T> out(n);
   if (n > 0 && H5Dread(set.id, memory_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
-    throw std::runtime_error(path_.string() + ": cannot read dataset " + name);
+    fail(path_.string() + ": cannot read dataset " + name);
   if (shape) *shape = dims;
   return out;
 }
@@ -131,23 +156,23 @@ hid_t open_object(hid_t file, const std::string& object) {
 void write_attribute(hid_t file, const std::filesystem::path& path, const std::string& object,
                      const std::string& key, hid_t type, const void* value) {
   Handle obj{open_object(file, object), H5Oclose};
-  if (obj.id < 0) throw std::runtime_error(path.string() + ": no object " + object);
+  if (obj.id < 0) fail(path.string() + ": no object " + object);
   if (H5Aexists(obj.id, key.c_str()) > 0) H5Adelete(obj.id, key.c_str());
   Handle space{H5Screate(H5S_SCALAR), H5Sclose};
   Handle attr{H5Acreate2(obj.id, key.c_str(), type, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
   if (attr.id < 0 || H5Awrite(attr.id, type, value) < 0)
-    throw std::runtime_error(path.string() + ": cannot write attribute " + object + "@" + key);
+    fail(path.string() + ": cannot write attribute " + object + "@" + key);
 }
 
 template <class T>
 T read_attribute(hid_t file, const std::filesystem::path& path, const std::string& object,
                  const std::string& key, hid_t type) {
   Handle obj{open_object(file, object), H5Oclose};
-  if (obj.id < 0) throw std::runtime_error(path.string() + ": no object " + object);
+  if (obj.id < 0) fail(path.string() + ": no object " + object);
   Handle attr{H5Aopen(obj.id, key.c_str(), H5P_DEFAULT), H5Aclose};
   T value{};
   if (attr.id < 0 || H5Aread(attr.id, type, &value) < 0)
-    throw std::runtime_error(path.string() + ": cannot read attribute " + object + "@" + key);
+    fail(path.string() + ": cannot read attribute " + object + "@" + key);
   return value;
 }
 
@@ -180,17 +205,16 @@ std::int64_t Hdf5File::attribute_int(const std::string& object, const std::strin
 
 std::string Hdf5File::attribute_string(const std::string& object, const std::string& key) const {
   Handle obj{open_object(file_, object), H5Oclose};
-  if (obj.id < 0) throw std::runtime_error(path_.string() + ": no object " + object);
+  if (obj.id < 0) fail(path_.string() + ": no object " + object);
   Handle attr{H5Aopen(obj.id, key.c_str(), H5P_DEFAULT), H5Aclose};
-  if (attr.id < 0)
-    throw std::runtime_error(path_.string() + ": no attribute " + object + "@" + key);
+  if (attr.id < 0) fail(path_.string() + ": no attribute " + object + "@" + key);
   Handle type{H5Aget_type(attr.id), H5Tclose};
   const std::size_t size = H5Tget_size(type.id);
   std::string value(size, '\0');
   Handle mem{H5Tcopy(H5T_C_S1), H5Tclose};
   H5Tset_size(mem.id, size);
   if (H5Aread(attr.id, mem.id, value.data()) < 0)
-    throw std::runtime_error(path_.string() + ": cannot read attribute " + object + "@" + key);
+    fail(path_.string() + ": cannot read attribute " + object + "@" + key);
   value.resize(value.find('\0') == std::string::npos ? size : value.find('\0'));
   return value;
 }

@@ -120,7 +120,7 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
 
 template <class Real>
 RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
-  const StartMode start = prepare_output_directory(o.out_dir, o.resume);
+  const StartMode start = prepare_output_directory(o.out_dir, o.resume, c.to_json());
   RunLog log(o.out_dir / "run.log", o.quiet);
   if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
   for (const auto& w : c.warnings) log.warning(w);
@@ -281,8 +281,15 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
 }  // namespace
 
 RunReport run_fluid_case(const cases::FluidCase& c, const RunOptions& options) {
-  return c.precision == cases::Precision::single_precision ? run_with_precision<float>(c, options)
-                                                           : run_with_precision<double>(c, options);
+  try {
+    return c.precision == cases::Precision::single_precision
+               ? run_with_precision<float>(c, options)
+               : run_with_precision<double>(c, options);
+  } catch (const input::InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    return failed_run(options.out_dir, e);  // I/O (a full disk) or another module's failure
+  }
 }
 
 }  // namespace flocsim::run

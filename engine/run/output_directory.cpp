@@ -1,15 +1,76 @@
 #include "engine/run/output_directory.hpp"
 
+#include <algorithm>
 #include <ctime>
 #include <fstream>
 
 #include "engine/input/input_reader.hpp"
+#include "engine/output/atomic_file.hpp"
 
 namespace flocsim::run {
 
 namespace fs = std::filesystem;
 
-StartMode prepare_output_directory(const fs::path& dir, bool resume) {
+namespace {
+
+// What a run writes besides its log, checkpoint and result.
+constexpr const char* kSnapshotFolders[] = {"fields", "spheres"};
+constexpr const char* kOutputFiles[] = {"fields.xdmf", "spheres.xdmf", "series.h5",
+                                        "progress.json"};
+
+// A snapshot file of output::snapshot_file (step_NNNNNNNNNN.h5) or the
+// temporary of one that a killed writer left (.step_NNNNNNNNNN.h5.tmp.*).
+bool is_snapshot_name(const std::string& name) {
+  auto snapshot = [](const std::string& n) {
+    if (n.size() != 18 || n.rfind("step_", 0) != 0 || n.substr(15) != ".h5") return false;
+    return std::all_of(n.begin() + 5, n.begin() + 15,
+                       [](char ch) { return ch >= '0' && ch <= '9'; });
+  };
+  if (snapshot(name)) return true;
+  const auto tmp = name.find(".tmp.");
+  return name.size() > 1 && name[0] == '.' && tmp != std::string::npos &&
+         snapshot(name.substr(1, tmp - 1));
+}
+
+// Removes the outputs of an earlier attempt of the same case, by name only.
+void remove_stale_outputs(const fs::path& dir) {
+  for (const char* folder : kSnapshotFolders) {
+    const fs::path f = dir / folder;
+    if (!fs::is_directory(fs::symlink_status(f))) continue;
+    for (const auto& e : fs::directory_iterator(f))
+      if (e.is_regular_file() && is_snapshot_name(e.path().filename().string()))
+        fs::remove(e.path());
+    if (fs::is_empty(f)) fs::remove(f);
+  }
+  for (const char* file : kOutputFiles)
+    if (fs::is_regular_file(fs::symlink_status(dir / file))) fs::remove(dir / file);
+}
+
+// Throws when a place a run writes to is taken by something it did not write.
+void refuse_foreign_outputs(const fs::path& dir) {
+  std::vector<std::string> taken;
+  for (const char* folder : kSnapshotFolders)
+    if (fs::exists(fs::symlink_status(dir / folder))) taken.push_back(folder);
+  for (const char* file : kOutputFiles)
+    if (fs::exists(fs::symlink_status(dir / file))) taken.push_back(file);
+  if (taken.empty()) return;
+  std::string list;
+  for (const auto& t : taken) list += (list.empty() ? "" : ", ") + (dir / t).string();
+  throw input::InputError(list + ": in the place of this run's output, and " +
+                          (dir / kRunRecord).string() +
+                          " does not say a run of this case wrote it; flocsim removes only what "
+                          "it wrote, so move it away or use another --out directory");
+}
+
+}  // namespace
+
+StartMode prepare_output_directory(const fs::path& dir, bool resume,
+                                   const nlohmann::json& case_json) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw input::InputError(dir.string() +
+                            ": exists and is not a directory; --out must name a "
+                            "directory");
   fs::create_directories(dir);
   const bool completed = fs::exists(dir / "result.json");
   const bool checkpoint = fs::exists(dir / "checkpoint.h5");
@@ -24,9 +85,35 @@ StartMode prepare_output_directory(const fs::path& dir, bool resume) {
     throw input::InputError((dir / "checkpoint.h5").string() +
                             " exists: continue it with --resume, or use another --out directory");
   }
-  for (const char* stale : {"fields", "spheres"}) fs::remove_all(dir / stale);
-  for (const char* stale : {"fields.xdmf", "spheres.xdmf", "series.h5", "progress.json"})
-    fs::remove(dir / stale);
+  const fs::path record = dir / kRunRecord;
+  bool same_case = false;
+  if (fs::exists(record)) {
+    nlohmann::json recorded;
+    try {
+      std::ifstream in(record);
+      recorded = nlohmann::json::parse(in).at("case");
+    } catch (const std::exception&) {
+      throw input::InputError(record.string() +
+                              ": not a run record written by flocsim; move it away or use "
+                              "another --out directory");
+    }
+    if (!resumable_under(recorded, case_json))
+      throw input::InputError(dir.string() + " holds the output of a different case (" +
+                              record.string() + "); use another --out directory");
+    same_case = true;
+  }
+  if (same_case)
+    remove_stale_outputs(dir);
+  else
+    refuse_foreign_outputs(dir);
+  output::write_file_atomically(
+      record, nlohmann::json{{"case", case_json},
+                             {"written_by", "flocsim run"},
+                             {"what",
+                              "the case whose output this directory holds; a fresh start "
+                              "of the same case may replace its snapshots"}}
+                      .dump(2) +
+                  "\n");
   return StartMode::fresh;
 }
 
@@ -36,6 +123,21 @@ RunReport completed_run(const fs::path& dir, RunLog& log) {
   r.outcome = RunOutcome::completed;
   std::ifstream in(dir / "result.json");
   r.result = nlohmann::json::parse(in);
+  return r;
+}
+
+RunReport failed_run(const fs::path& dir, const std::exception& e) {
+  RunReport r;
+  r.outcome = RunOutcome::failed;
+  r.message = e.what();
+  if (fs::is_directory(dir)) {
+    try {
+      RunLog(dir / "run.log", true).error(r.message);
+    } catch (const std::exception&) {
+      // the log cannot be written either (a full disk): the message still
+      // reaches the caller, and through it stderr
+    }
+  }
   return r;
 }
 

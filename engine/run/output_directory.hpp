@@ -4,8 +4,13 @@
 //     fresh start refuses to overwrite it;
 //   - checkpoint.h5 present: --resume continues from it, a fresh start
 //     refuses (it would silently discard the work);
-//   - otherwise a fresh start, after removing snapshot output an earlier,
-//     never-checkpointed attempt may have left.
+//   - otherwise a fresh start. A run removes only files it can prove it
+//     wrote: the directory's run record (kRunRecord) names the case whose
+//     output it holds, and an earlier, never-checkpointed attempt of the same
+//     case leaves stale snapshots and series that are removed, file by file,
+//     by their names. Anything else is the user's: a directory that holds
+//     something in the place of a run output, and no run record of this case,
+//     is refused, and nothing in it is touched.
 // Refusals are input errors naming the file and the way out.
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -18,7 +23,12 @@ namespace flocsim::run {
 
 enum class StartMode { fresh, from_checkpoint, already_completed };
 
-StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume);
+// The file in an output directory that records which case's output it holds.
+inline constexpr const char* kRunRecord = "flocsim-run.json";
+
+// `case_json` is the canonical case (to_json()) of the run about to start.
+StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume,
+                                   const nlohmann::json& case_json);
 
 // The report of a run found complete (StartMode::already_completed): its
 // stored result.json, untouched.
@@ -30,6 +40,11 @@ RunReport completed_run(const std::filesystem::path& dir, RunLog& log);
 RunReport blown_up_run(RunLog& log, const std::string& where, const std::string& what,
                        long last_good_checkpoint, const std::filesystem::path& checkpoint,
                        const std::string& likely_causes);
+
+// The report of a run a module gave up on (event cap, I/O such as a full
+// disk): the reason, also written to the run's log when the directory exists.
+// The last checkpoint stays for a look or a --resume after the cause is fixed.
+RunReport failed_run(const std::filesystem::path& dir, const std::exception& e);
 
 // Now, as result.json's completed_at: ISO 8601 in UTC.
 std::string utc_timestamp();

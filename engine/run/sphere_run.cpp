@@ -818,14 +818,7 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
   } catch (const input::InputError&) {
     throw;
   } catch (const std::exception& e) {
-    // a module gave up (event cap, I/O): say so in the run's log too; the
-    // last checkpoint stays for a look or a --resume after the cause is fixed
-    RunReport r;
-    r.outcome = RunOutcome::failed;
-    r.message = e.what();
-    if (std::filesystem::is_directory(o.out_dir))
-      RunLog(o.out_dir / "run.log", true).error(r.message);
-    return r;
+    return failed_run(o.out_dir, e);  // a module gave up (event cap, I/O)
   }
 }
 

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -354,6 +355,111 @@ TEST_F(Orchestrator, BadInputGetsClearErrorsAndExitCode2) {
   o = t::run(flocsim({"query", "--db", db_, "--where", "nosuch=1"}));
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.out.find("no column or case field \"nosuch\""), std::string::npos) << o.out;
+}
+
+TEST_F(Orchestrator, RefusedSweepFilesLeaveNoDatabaseBehind) {
+  // a directory given as the sweep file
+  fs::create_directories(dir_ / "adir");
+  t::Output o = t::run(launch((dir_ / "adir").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("adir: is a directory, not a JSON file"), std::string::npos) << o.out;
+  // a grid refused at expansion (two points give one case)
+  // a grid refused only when it is expanded: an axis through a number
+  t::write_text(dir_ / "through.json",
+                R"({"name": "t", "base": {"y": 1}, "axes": {"x": [1], "y.z": [2]}})");
+  o = t::run(launch((dir_ / "through.json").string()));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("goes through base.y = 1, which is not an object"), std::string::npos)
+      << o.out;
+  EXPECT_FALSE(fs::exists(db_)) << "a refused sweep left " << db_;
+}
+
+TEST_F(Orchestrator, RelaunchingASweepNameWithAnotherBaseIsRefused) {
+  // Same name, changed base: the two grids would be merged into one sweep and
+  // `query` would show rows with the same axis values.
+  ASSERT_EQ(t::run(launch(fake_sweep({1, 2}, 1, 1))).code, 0);
+  json changed{{"name", "fake"},
+               {"base", {{"x", 0}, {"fake", {{"steps", 2}, {"step_ms", 1}}}}},
+               {"axes", {{"x", {1, 2}}}}};
+  t::write_text(dir_ / "changed.json", changed.dump());
+  t::Output o = t::run(launch((dir_ / "changed.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("was launched with base.fake.steps = 1; this file has 2"), std::string::npos)
+      << o.out;
+  EXPECT_NE(o.out.find("another \"name\""), std::string::npos) << o.out;
+  // other axes are refused too; more values on the same axes grow the grid
+  changed["base"]["fake"]["steps"] = 1;
+  changed["axes"] = {{"fake.step_ms", {1, 2}}};
+  t::write_text(dir_ / "axes.json", changed.dump());
+  o = t::run(launch((dir_ / "axes.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("was launched with the axes x; this file has fake.step_ms"),
+            std::string::npos)
+      << o.out;
+  EXPECT_EQ(t::run(launch(fake_sweep({1, 2, 3}, 1, 1))).code, 0);
+  EXPECT_EQ(statuses().size(), 3u);
+}
+
+TEST_F(Orchestrator, WhereRefusesTextAgainstANumber) {
+  // 'x<abc' compared as text and returned every row
+  ASSERT_EQ(t::run(launch(fake_sweep({1, 2}, 1, 1))).code, 0);
+  t::Output o = t::run(flocsim({"query", "--db", db_, "--where", "x<abc"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("x is a number, \"abc\" is not"), std::string::npos) << o.out;
+  o = t::run(flocsim({"query", "--db", db_, "--where", "x<1.5", "--format", "csv"}));
+  EXPECT_EQ(o.code, 0) << o.out;
+  EXPECT_EQ(std::count(o.out.begin(), o.out.end(), '\n'), 2) << o.out;  // header + one run
+  o = t::run(flocsim({"query", "--db", db_, "--where", "status=completed"}));
+  EXPECT_EQ(o.code, 0) << o.out;  // text against a text column stays allowed
+}
+
+TEST_F(Orchestrator, AFileThatIsNotSqliteIsNamed) {
+  t::write_text(dir_ / "notes.db", "these are my notes, not a database\n");
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{"query", "--db", (dir_ / "notes.db").string()},
+        std::vector<std::string>{"sweep", "status", "--db", (dir_ / "notes.db").string()}}) {
+    const t::Output o = t::run(flocsim(cmd));
+    EXPECT_EQ(o.code, 1);
+    EXPECT_NE(o.out.find((dir_ / "notes.db").string() + ": not an SQLite database"),
+              std::string::npos)
+        << o.out;
+  }
+  const t::Output o = t::run(flocsim({"sweep", "launch", fake_sweep({1}, 1, 1), "--db",
+                                      (dir_ / "notes.db").string(), "--worker", FAKE_WORKER_EXE}));
+  EXPECT_NE(o.code, 0);
+  EXPECT_EQ(t::read_text(dir_ / "notes.db"), "these are my notes, not a database\n");
+}
+
+TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
+  // On a read-only file system `query` and `status`, which only read, failed
+  // with "unable to open database file". Root ignores file permissions, so
+  // the test mounts the folder read-only (and skips where it cannot).
+  const fs::path rw = dir_ / "rw", ro = dir_ / "ro";
+  fs::create_directories(rw);
+  fs::create_directories(ro);
+  const std::string db = (rw / "results.db").string();
+  ASSERT_EQ(t::run(flocsim({"sweep", "launch", fake_sweep({1, 2}, 1, 1), "--db", db, "--worker",
+                            FAKE_WORKER_EXE}))
+                .code,
+            0);
+  if (::geteuid() != 0 ||
+      std::system(("mount --bind " + rw.string() + " " + ro.string() +
+                   " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
+                      .c_str()) != 0) {
+    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+    GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
+  }
+  const std::string ro_db = (ro / "results.db").string();
+  const t::Output q = t::run(flocsim({"query", "--db", ro_db, "--format", "csv"}));
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", ro_db}));
+  const t::Output w = t::run(flocsim({"sweep", "resume", "--db", ro_db}));
+  std::system(("umount " + ro.string()).c_str());
+  EXPECT_EQ(q.code, 0) << q.out;
+  EXPECT_EQ(std::count(q.out.begin(), q.out.end(), '\n'), 3) << q.out;  // header + 2 runs
+  EXPECT_EQ(st.code, 0) << st.out;
+  EXPECT_NE(st.out.find("is read-only"), std::string::npos) << st.out;
+  EXPECT_EQ(w.code, 1) << w.out;
+  EXPECT_NE(w.out.find(ro_db + " is read-only"), std::string::npos) << w.out;
 }
 
 // The real worker: the CI sweep with `flocsim run`, then a real run killed with

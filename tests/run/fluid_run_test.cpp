@@ -5,10 +5,12 @@
 #include "engine/run/fluid_run.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -191,6 +193,120 @@ TEST(FluidRun, TaylorGreenCarriedByAMeanFlowDecaysAtTheAnalyticRate) {
   ASSERT_EQ(r.outcome, RunOutcome::completed);
   EXPECT_NEAR(r.result["observables"]["viscosity_measured"].get<double>() / 0.02, 1.0, 0.02);
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace flocsim::run
+
+namespace flocsim::run {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using flocsim::testing::fresh_dir;
+
+cases::FluidCase small_case(double viscosity) {
+  return cases::parse_fluid_case(
+      json{{"scene", "fluid"},
+           {"fluid", {{"size", {8, 4, 4}}, {"viscosity", viscosity}}},
+           {"run", {{"steps", 20}, {"write_fields", true}, {"fields_every", 5}}}});
+}
+
+std::string text_of(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
+  // The reproducer of the report: a folder holding the user's spheres/mine.txt
+  // and a file called `fields`; the fresh run removed both and exited 0.
+  const fs::path o = fresh_dir("users_files");
+  fs::create_directories(o / "spheres");
+  std::ofstream(o / "spheres" / "mine.txt") << "mine\n";
+  std::ofstream(o / "fields") << "notes\n";
+  std::ofstream(o / "case.json") << "{}\n";  // unrelated files are no obstacle
+  try {
+    run_fluid_case(small_case(0.05), {o, false, true, 0});
+    ADD_FAILURE() << "a run started over the user's files";
+  } catch (const input::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("flocsim removes only what it wrote"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(text_of(o / "spheres" / "mine.txt"), "mine\n");
+  EXPECT_EQ(text_of(o / "fields"), "notes\n");
+  EXPECT_EQ(text_of(o / "case.json"), "{}\n");
+  // without the colliding names the run goes ahead and leaves case.json alone
+  fs::remove(o / "fields");
+  fs::remove_all(o / "spheres");
+  EXPECT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 0}).outcome, RunOutcome::completed);
+  EXPECT_EQ(text_of(o / "case.json"), "{}\n");
+  fs::remove_all(o);
+}
+
+TEST(OutputDirectory, AFreshStartOfTheSameCaseReplacesOnlyItsOwnSnapshots) {
+  // An attempt that died before its first checkpoint left snapshots; the next
+  // attempt of the same case (the orchestrator's retry) removes those by name
+  // and keeps whatever else is in the folders.
+  const fs::path o = fresh_dir("same_case");
+  ASSERT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 12}).outcome,
+            RunOutcome::interrupted);
+  ASSERT_EQ(output::snapshot_steps(o / "fields"), (std::vector<long>{5, 10}));
+  fs::remove(o / "checkpoint.h5");  // as if it had died before the checkpoint
+  std::ofstream(o / "fields" / "notes.txt") << "keep\n";
+  std::ofstream(o / "fields" / ".step_0000000015.h5.tmp.4242") << "half";  // a killed writer's
+  ASSERT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 7}).outcome, RunOutcome::interrupted);
+  EXPECT_EQ(output::snapshot_steps(o / "fields"), (std::vector<long>{5}));
+  EXPECT_EQ(text_of(o / "fields" / "notes.txt"), "keep\n");
+  EXPECT_FALSE(fs::exists(o / "fields" / ".step_0000000015.h5.tmp.4242"));
+  // another case in the same folder is refused, and nothing is touched
+  fs::remove(o / "checkpoint.h5");
+  try {
+    run_fluid_case(small_case(0.06), {o, false, true, 0});
+    ADD_FAILURE() << "another case ran over this one's output";
+  } catch (const input::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds the output of a different case"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(output::snapshot_steps(o / "fields"), (std::vector<long>{5}));
+  fs::remove_all(o);
+}
+
+TEST(DiskFull, TheMessageSaysNoSpaceLeftOnDevice) {
+  // /dev/full accepts the open and fails every write with ENOSPC, as a full
+  // disk does; HDF5's own text ("cannot write dataset ...") lacked the reason.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  try {
+    output::Hdf5File f("/dev/full", output::Hdf5File::Mode::create);
+    const std::vector<double> x(1 << 16, 1.0);
+    f.write("/x", {x.size()}, x.data());
+    f.close();
+    ADD_FAILURE() << "wrote to /dev/full";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DiskFull, AFluidRunSaysSoInItsLog) {
+  // A fluid run on a 1 MiB file system: the failure and its reason reach
+  // run.log, not only stderr. Needs root to mount the file system.
+  const fs::path o = fresh_dir("disk_full");
+  fs::create_directories(o);
+  if (::geteuid() != 0 ||
+      std::system(("mount -t tmpfs -o size=1m tmpfs " + o.string() + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a small tmpfs here (needs root)";
+  cases::FluidCase c = cases::parse_fluid_case(
+      json{{"scene", "fluid"},
+           {"fluid", {{"size", {32, 32, 32}}, {"viscosity", 0.05}}},
+           {"run", {{"steps", 20}, {"write_fields", true}, {"fields_every", 5}}}});
+  const RunReport r = run_fluid_case(c, {o / "run", false, true, 0});
+  const std::string log = text_of(o / "run" / "run.log");
+  std::system(("umount " + o.string()).c_str());
+  EXPECT_EQ(r.outcome, RunOutcome::failed);
+  EXPECT_NE(r.message.find("No space left on device"), std::string::npos) << r.message;
+  EXPECT_NE(log.find("No space left on device"), std::string::npos) << log;
+  fs::remove_all(o);
 }
 
 }  // namespace
