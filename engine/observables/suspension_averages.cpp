@@ -107,6 +107,39 @@ double integrated_correlation_time(const std::vector<double>& series) {
   return tau;
 }
 
+Drift window_drift(const std::vector<double>& series, double z_limit) {
+  Drift out;
+  const std::size_t n = series.size();
+  if (n < 3) return out;
+  const double t_mean = 0.5 * static_cast<double>(n - 1);
+  double x_mean = 0;
+  for (double x : series) x_mean += x;
+  x_mean /= static_cast<double>(n);
+  double s_tt = 0, s_tx = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) - t_mean;
+    s_tt += t * t;
+    s_tx += t * (series[k] - x_mean);
+  }
+  const double slope = s_tx / s_tt;
+  std::vector<double> residual(n);
+  double ss = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    residual[k] = series[k] - x_mean - slope * (static_cast<double>(k) - t_mean);
+    ss += residual[k] * residual[k];
+  }
+  out.change = slope * static_cast<double>(n - 1);
+  const double variance = ss / static_cast<double>(n - 2);
+  if (variance <= 0) {  // an exact line: any slope is a trend
+    out.z = slope == 0 ? 0 : std::copysign(INFINITY, slope);
+  } else {
+    const double se = std::sqrt(variance * integrated_correlation_time(residual) / s_tt);
+    out.z = slope / se;
+  }
+  out.stationary = std::abs(out.z) <= z_limit;
+  return out;
+}
+
 bool is_stationary(const std::vector<double>& series, long window, double tolerance) {
   const long n = static_cast<long>(series.size());
   if (window < 5 || n < 2 * window) return false;

@@ -46,6 +46,18 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches);
 // Integrated autocorrelation time of a series, in samples (see SteadyAverage).
 double integrated_correlation_time(const std::vector<double>& series);
 
+// A slow drift over a statistics window, which batch means alone do not see
+// (a rising <n_a> gives a tidy mean and a small error). The least-squares
+// slope b of the series against the sample index, with its standard error
+// widened by the residuals' integrated correlation time tau (an AR(1) series
+// has var(b) ~ tau sigma^2 / S_tt), gives z = b / se(b); |z| > 3 is a trend.
+struct Drift {
+  double change = 0;  // b (n - 1): the trend's change over the window
+  double z = 0;       // b / se(b)
+  bool stationary = true;
+};
+Drift window_drift(const std::vector<double>& series, double z_limit = 3.0);
+
 // Dynamically stationary: the means of the last two windows of `window`
 // samples differ by less than `tolerance` standard errors of their difference
 // (batch-means errors, 5 batches per window). False while fewer than

@@ -174,5 +174,31 @@ TEST(Stationarity, DetectsTheEndOfAnExponentialRelaxation) {
   EXPECT_FALSE(is_stationary(std::vector<double>(600, 1.0), 500));  // too short to judge
 }
 
+TEST(WindowDrift, AcceptsStationaryAr1AndRejectsASlowDrift) {
+  // AR(1) with rho = 0.9 (tau = 19 samples), 20,000 samples: by hand the
+  // standard error of the change over the window is sqrt(12 tau / n) = 0.107
+  // noise units, so a drift of one noise standard deviation over the window
+  // (which moves the mean by 0.5 where the batch-means error is about 0.03)
+  // gives z ~ 9, and no drift gives |z| <= 3 but for 0.3 % of series.
+  const long n = 20000;
+  int accepted = 0, rejected = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const std::vector<double> still = ar1(n, 0.9, seed);
+    accepted += window_drift(still).stationary;
+    std::vector<double> drifting = still;
+    for (long k = 0; k < n; ++k) drifting[k] += static_cast<double>(k) / (n - 1);
+    const Drift d = window_drift(drifting);
+    rejected += !d.stationary;
+    EXPECT_NEAR(d.change, 1.0, 4 * 0.107) << seed;  // the trend is measured, within 4 se
+  }
+  EXPECT_EQ(accepted, 20);
+  EXPECT_EQ(rejected, 20);
+  // a rising but saturating series (an aggregate size still growing) is a trend
+  std::vector<double> rising(4000);
+  for (std::size_t k = 0; k < rising.size(); ++k)
+    rising[k] = 10 * (1 - std::exp(-static_cast<double>(k) / 4000.0)) + 0.3 * ar1(4000, 0.5, 3)[k];
+  EXPECT_FALSE(window_drift(rising).stationary);
+}
+
 }  // namespace
 }  // namespace flocsim::observables
