@@ -364,6 +364,18 @@ TEST_F(Orchestrator, RefusedSweepFilesLeaveNoDatabaseBehind) {
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.out.find("adir: is a directory, not a JSON file"), std::string::npos) << o.out;
   // a grid refused at expansion (two points give one case)
+  // nested 50,000 deep (it crashed `sweep launch`), and a key given twice
+  t::write_text(dir_ / "deep.json", "{\"name\": \"d\", \"base\": " + std::string(50000, '[') +
+                                        std::string(50000, ']') + "}");
+  o = t::run(launch((dir_ / "deep.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("base[0][0]"), std::string::npos) << o.out.substr(0, 500);
+  EXPECT_NE(o.out.find("nested deeper than 64 levels"), std::string::npos) << o.out.substr(0, 500);
+  t::write_text(dir_ / "dup.json",
+                R"({"name": "d", "base": {"x": 1}, "axes": {"x": [1]}, "name": "e"})");
+  o = t::run(launch((dir_ / "dup.json").string()));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("dup.json: name: key given twice"), std::string::npos) << o.out;
   // a grid refused only when it is expanded: an axis through a number
   t::write_text(dir_ / "through.json",
                 R"({"name": "t", "base": {"y": 1}, "axes": {"x": [1], "y.z": [2]}})");
