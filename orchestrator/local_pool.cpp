@@ -15,6 +15,8 @@
 #include <thread>
 
 #include "engine/input/input_reader.hpp"
+#include "engine/process/exit_codes.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "orchestrator/process.hpp"
 
 namespace flocsim::orchestrator {
@@ -22,23 +24,6 @@ namespace flocsim::orchestrator {
 namespace fs = std::filesystem;
 using db::unix_now;
 using nlohmann::json;
-
-std::atomic<int> g_stop_requests{0};
-
-namespace {
-void on_stop_signal(int) {
-  g_stop_requests.fetch_add(1);
-}
-}  // namespace
-
-void install_stop_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 std::string default_runs_dir(const std::string& db_path) {
   fs::path p = fs::absolute(db_path);
@@ -350,15 +335,15 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
       why = buf;
     } else if (exit_code) {
       switch (*exit_code) {
-        case 0:
+        case process::kExitOk:
           state = "failed";
           why = "worker exited 0 but its result is not usable: " + rr.problem;
           break;
-        case 2:
+        case process::kExitBadInput:
           state = "refused";
           why = "case refused (exit 2): " + tail;
           break;
-        case 3:
+        case process::kExitInterrupted:
           state = "interrupted";
           why = "stopped by a signal after writing a checkpoint (exit 3)";
           break;
@@ -389,7 +374,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
   double last_heartbeat_write = 0;
   double stop_seen = 0;
   while (true) {
-    const int stops = g_stop_requests.load();
+    const int stops = process::stop_requests();
     const double now = unix_now();
     if (stops > 0 && stop_seen == 0) {
       stop_seen = now;

@@ -2,7 +2,6 @@
 // The local backend: a pool of worker processes (`flocsim run CASE --out DIR`)
 // fed from the results database, and the bookkeeping every backend shares:
 // registering a sweep, finding lost workers.
-#include <atomic>
 #include <functional>
 #include <optional>
 #include <ostream>
@@ -13,11 +12,6 @@
 #include "orchestrator/sweep.hpp"
 
 namespace flocsim::orchestrator {
-
-// Set by the SIGINT/SIGTERM handler of the command; counts signals received.
-// The first asks for a graceful stop (workers checkpoint), the second kills.
-extern std::atomic<int> g_stop_requests;
-void install_stop_handlers();
 
 struct Registered {
   db::SweepRecord sweep;

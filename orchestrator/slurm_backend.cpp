@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
 
@@ -158,7 +159,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   bool cancelled = false;
   std::size_t last_done = static_cast<std::size_t>(-1);
   while (true) {
-    if (g_stop_requests.load() > 0 && !cancelled) {
+    if (process::stop_requests() > 0 && !cancelled) {
       say(l.out, "slurm: stopping: scancel " + sum.job_id + " (tasks checkpoint their runs)");
       run_program({"scancel", sum.job_id}, nullptr);
       cancelled = true;

@@ -9,9 +9,9 @@
 #include "engine/case/fluid_case.hpp"
 #include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "engine/run/fluid_run.hpp"
 #include "engine/run/sphere_run.hpp"
-#include "engine/run/stop_signal.hpp"
 
 namespace flocsim::app {
 namespace {
@@ -54,7 +54,7 @@ int run_command(const RunArguments& a) {
                  named ? "" : a.case_file.c_str(), what.c_str());
     return kExitBadInput;
   }
-  run::install_stop_handlers();
+  process::install_stop_handlers(process::SecondSignal::ends_the_process);
   run::RunOptions options;
   options.out_dir = a.out_dir;
   options.resume = a.resume;

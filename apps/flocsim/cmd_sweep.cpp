@@ -12,6 +12,7 @@
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
 #include "orchestrator/report.hpp"
@@ -89,7 +90,7 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
     launch.lease_s = o.lease_s;
     launch.wait = !o.no_wait;
     launch.out = &std::cout;
-    orc::install_stop_handlers();
+    process::install_stop_handlers(process::SecondSignal::is_counted);
     const orc::SlurmSummary s = orc::run_slurm(db, sweep, launch);
     if (!launch.wait) return kExitOk;
     orc::write_status(db, sweep.name, std::cout);
@@ -102,7 +103,7 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
   p.lease_s = o.lease_s;
   p.grace_s = o.grace_s;
   p.out = &std::cout;
-  orc::install_stop_handlers();
+  process::install_stop_handlers(process::SecondSignal::is_counted);
   const orc::PoolSummary s = orc::run_pool(db, sweep, p);
   print_summary(s, db, sweep);
   return exit_code_for(db, sweep, s.stopped);
@@ -218,7 +219,7 @@ const bool registered = register_command(
            if (*action == "slurm-task") {
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
-             orc::install_stop_handlers();
+             process::install_stop_handlers(process::SecondSignal::is_counted);
              return orc::run_slurm_task(db, sweep, o->task_file, o->worker, o->lease_s, std::cout);
            }
          } catch (const flocsim::input::InputError& e) {

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/process/exit_codes.hpp"
+
 namespace flocsim::app {
 
 using CommandHandler = std::function<int()>;
@@ -25,10 +27,11 @@ struct Command {
 bool register_command(Command command);
 const std::vector<Command>& commands();
 
-// Exit codes shared by all subcommands (documented in docs/user-guide.md).
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;      // the run failed (numerical blow-up, I/O error)
-inline constexpr int kExitBadInput = 2;     // input refused before any work started
-inline constexpr int kExitInterrupted = 3;  // stopped by a signal after writing a checkpoint
+// Exit codes shared by all subcommands and the orchestrator's workers
+// (docs/user-guide.md): defined once, in engine/process/exit_codes.hpp.
+using process::kExitBadInput;
+using process::kExitFailure;
+using process::kExitInterrupted;
+using process::kExitOk;
 
 }  // namespace flocsim::app

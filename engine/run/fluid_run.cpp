@@ -12,10 +12,10 @@
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
-#include "engine/run/stop_signal.hpp"
 
 #ifndef FLOCSIM_VERSION
 #define FLOCSIM_VERSION "0.1.0"
@@ -181,8 +181,8 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
       write_fields(o.out_dir, fluid);
       output_s += seconds_since(t1);
     }
-    const bool stop_now =
-        stop_requested() != 0 || (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
+    const bool stop_now = process::stop_requested() != 0 ||
+                          (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
     const bool checkpoint_due = seconds_since(last_checkpoint) >= c.run.checkpoint_every_s ||
                                 (o.checkpoint_every_steps > 0 && t % o.checkpoint_every_steps == 0);
     if ((stop_now || checkpoint_due) && t < c.run.steps) {
@@ -195,10 +195,11 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
       last_good_checkpoint_step = t;
       if (stop_now) {
         progress.finish(t);
-        log.info(
-            "stopped at step " + std::to_string(t) +
-            (stop_requested() ? " by signal " + std::to_string(stop_requested()) : std::string()) +
-            "; checkpoint written, continue with --resume");
+        log.info("stopped at step " + std::to_string(t) +
+                 (process::stop_requested()
+                      ? " by signal " + std::to_string(process::stop_requested())
+                      : std::string()) +
+                 "; checkpoint written, continue with --resume");
         RunReport r;
         r.outcome = RunOutcome::interrupted;
         return r;

@@ -26,10 +26,10 @@
 #include "engine/output/hdf5_file.hpp"
 #include "engine/output/sphere_snapshots.hpp"
 #include "engine/placement/random_placement.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
-#include "engine/run/stop_signal.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
 
 #ifndef FLOCSIM_VERSION
@@ -636,7 +636,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                                     s.spheres, agg.aggregate_of);
       output_s += seconds_since(t0);
     }
-    const bool stop_now = stop_requested() != 0 ||
+    const bool stop_now = process::stop_requested() != 0 ||
                           (o.stop_after_steps > 0 && s.step - first_step >= o.stop_after_steps);
     const bool checkpoint_due =
         seconds_since(last_checkpoint) >= c.checkpoint_every_s ||

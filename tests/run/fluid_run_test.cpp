@@ -16,7 +16,7 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
-#include "engine/run/stop_signal.hpp"
+#include "engine/process/stop_signal.hpp"
 #include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
@@ -125,9 +125,9 @@ TEST(FluidRun, BlowUpStopsWithDiagnosisAndKeepsLastGoodCheckpoint) {
 TEST(FluidRun, SignalStopsTheRunWithACheckpoint) {
   const cases::FluidCase c = shear_wave_case("double");
   const fs::path dir = fresh_dir("signal");
-  request_stop(SIGTERM);
+  process::request_stop(SIGTERM);
   const RunReport r = run_fluid_case(c, {dir, false, true, 0});
-  clear_stop_request();
+  process::clear_stop_request();
   EXPECT_EQ(r.outcome, RunOutcome::interrupted);
   EXPECT_TRUE(fs::exists(dir / "checkpoint.h5"));
   EXPECT_FALSE(fs::exists(dir / "result.json"));
