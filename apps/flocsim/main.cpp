@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <string>
 
 #include "apps/flocsim/command_registry.hpp"
 
@@ -41,6 +42,16 @@ int main(int argc, char** argv) {
   for (const Command& c : sorted) {
     CLI::App* sub = app.add_subcommand(c.name, c.description);
     handlers[sub] = c.setup(*sub);
+  }
+  // CLI11 answers an unknown first word with "A subcommand is required": name it
+  if (argc > 1 && argv[1][0] != '-' &&
+      std::none_of(sorted.begin(), sorted.end(),
+                   [&](const Command& c) { return c.name == argv[1]; })) {
+    std::string known;
+    for (const Command& c : sorted) known += (known.empty() ? "" : ", ") + c.name;
+    std::fprintf(stderr, "flocsim: %.80s: no such subcommand (subcommands: %s; see --help)\n",
+                 argv[1], known.c_str());
+    return kExitBadInput;
   }
   try {
     app.parse(argc, argv);

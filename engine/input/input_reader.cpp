@@ -285,6 +285,10 @@ std::string read_input_text(const std::string& filename) {
   const fs::file_status st = fs::status(filename, ec);
   if (ec || !fs::exists(st)) throw InputError(filename + ": cannot be opened: no such file");
   if (fs::is_directory(st)) throw InputError(filename + ": is a directory, not a JSON file");
+  // a FIFO would block the reader and a device never end: only plain files
+  if (!fs::is_regular_file(st))
+    throw InputError(filename +
+                     ": not a regular file (a pipe, device or socket); give a JSON file");
   const std::uintmax_t bytes = fs::file_size(filename, ec);
   if (!ec && bytes > kMaxInputFileBytes)
     throw InputError(filename + ": " + std::to_string(bytes) + " bytes; input files are at most " +

@@ -64,8 +64,25 @@ void refuse_foreign_outputs(const fs::path& dir) {
 
 }  // namespace
 
+namespace {
+StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_json);
+}
+
 StartMode prepare_output_directory(const fs::path& dir, bool resume,
                                    const nlohmann::json& case_json) {
+  try {
+    return prepare(dir, resume, case_json);
+  } catch (const fs::filesystem_error& e) {
+    // a name too long, a folder not writable: an input error, with the path cut short
+    const std::string shown =
+        dir.string().size() > 120 ? dir.string().substr(0, 120) + "..." : dir.string();
+    throw input::InputError("--out " + shown + ": cannot prepare the output directory (" +
+                            e.code().message() + ")");
+  }
+}
+
+namespace {
+StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_json) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw input::InputError(dir.string() +
@@ -116,6 +133,7 @@ StartMode prepare_output_directory(const fs::path& dir, bool resume,
                   "\n");
   return StartMode::fresh;
 }
+}  // namespace
 
 RunReport completed_run(const fs::path& dir, RunLog& log) {
   log.info("already completed: " + (dir / "result.json").string() + " is kept as it is");

@@ -3,6 +3,7 @@
 // allowed, and none crashes, hangs or echoes megabytes back.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -127,6 +128,16 @@ TEST(InputFile, DirectoryAndMissingFileAreNamed) {
   EXPECT_THAT(refusal_of_file(dir), AllOf(HasSubstr(dir.string()), HasSubstr("is a directory")));
   fs::remove(dir);
   EXPECT_THAT(refusal_of_file(dir), AllOf(HasSubstr(dir.string()), HasSubstr("no such file")));
+}
+
+TEST(InputFile, APipeOrDeviceIsRefusedWithoutBlocking) {
+  // A FIFO with no writer blocked the reader forever; /dev/zero never ends.
+  const fs::path fifo = write_file("fifo", "");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THAT(refusal_of_file(fifo), HasSubstr("not a regular file"));
+  fs::remove(fifo);
+  EXPECT_THAT(refusal_of_file("/dev/zero"), HasSubstr("not a regular file"));
 }
 
 }  // namespace

@@ -357,6 +357,30 @@ TEST_F(Orchestrator, BadInputGetsClearErrorsAndExitCode2) {
   EXPECT_NE(o.out.find("no column or case field \"nosuch\""), std::string::npos) << o.out;
 }
 
+TEST_F(Orchestrator, CommandLineMistakesAreNamed) {
+  t::Output o = t::run(flocsim({"frobnicate"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("frobnicate: no such subcommand (subcommands: "), std::string::npos)
+      << o.out;
+  t::write_text(dir_ / "fluid.json",
+                R"({"scene": "fluid", "fluid": {"size": [8, 8, 8], "viscosity": 0.05},
+                    "run": {"steps": 5}})");
+  o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", (dir_ / "o").string(),
+                      "--stop-after", "-1"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("--stop-after: must be a whole number of steps >= 0, got -1"),
+            std::string::npos)
+      << o.out;
+  EXPECT_LT(o.out.size(), 300u);  // not the 309-digit range of double
+  const std::string long_name = (dir_ / std::string(5000, 'x')).string();
+  o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", long_name}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("cannot prepare the output directory (File name too long)"),
+            std::string::npos)
+      << o.out.substr(0, 400);
+  EXPECT_LT(o.out.size(), 400u);
+}
+
 TEST_F(Orchestrator, RefusedSweepFilesLeaveNoDatabaseBehind) {
   // a directory given as the sweep file
   fs::create_directories(dir_ / "adir");
