@@ -765,7 +765,7 @@ std::vector<ResultsDb::ResultRow> ResultsDb::result_rows(std::optional<std::int6
     for (ResultRow& row : rows) by_id[row.run.id] = &row;
     Statement res(db_,
                   "SELECT run_id, wall_s, mlups, steps, window_json, completed_at, "
-                  "flocsim_version FROM results");
+                  "flocsim_version, result_json FROM results");
     while (res.step()) {
       auto it = by_id.find(res.text(0));
       if (it == by_id.end()) continue;
@@ -777,6 +777,7 @@ std::vector<ResultsDb::ResultRow> ResultsDb::result_rows(std::optional<std::int6
       row.window_json = res.text(4);
       row.completed_at = res.text(5);
       row.flocsim_version = res.text(6);
+      row.result_json = res.text(7);
     }
     Statement obs(db_, "SELECT run_id, name, mean, error FROM observables ORDER BY rowid");
     while (obs.step()) {

@@ -202,6 +202,7 @@ class ResultsDb {
     std::optional<double> wall_s, mlups;
     std::optional<std::int64_t> steps;
     std::string window_json, completed_at, flocsim_version;
+    std::string result_json;  // the whole result.json as recorded ("" without a result)
     std::vector<Observable> observables;
   };
   // Every run (of one sweep when given) with its result and observables.

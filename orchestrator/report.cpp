@@ -16,6 +16,26 @@ using flocsim::input::InputError;
 using nlohmann::json;
 using nlohmann::ordered_json;
 
+std::string format_with_error(double mean, std::optional<double> error,
+                              const std::string& plus_minus) {
+  char buf[96];
+  if (!std::isfinite(mean)) return mean != mean ? "nan" : (mean > 0 ? "inf" : "-inf");
+  if (!error || !(*error > 0) || !std::isfinite(*error)) {
+    std::snprintf(buf, sizeof buf, "%.4g", mean);
+    return buf;
+  }
+  // the decimal place of the error's first significant digit, after rounding
+  int place = static_cast<int>(std::floor(std::log10(*error)));
+  double rounded = std::round(*error / std::pow(10.0, place)) * std::pow(10.0, place);
+  place = static_cast<int>(std::floor(std::log10(rounded)));  // 0.0096 -> 0.01
+  const int decimals = std::max(0, -place);
+  const double unit = std::pow(10.0, place);
+  const double m = std::round(mean / unit) * unit;
+  std::snprintf(buf, sizeof buf, "%.*f%s%.*f", decimals, m == 0 ? 0.0 : m, plus_minus.c_str(),
+                decimals, rounded);
+  return buf;
+}
+
 Filter parse_filter(const std::string& text) {
   static const char* ops[] = {"!=", "<=", ">=", "==", "=", "<", ">"};
   for (std::size_t pos = 0; pos < text.size(); ++pos)
@@ -128,7 +148,19 @@ bool as_number(const json& v, double& out) {
   return false;
 }
 
-bool matches(const json& v, const Filter& f) {
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"') out += '"';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+bool filter_matches(const json& v, const Filter& f) {
   if (v.is_null()) return false;
   double a = 0, b = 0;
   if (as_number(v, a) && as_number(json(f.value), b)) {
@@ -149,18 +181,6 @@ bool matches(const json& v, const Filter& f) {
   if (f.op == ">") return s > f.value;
   return s >= f.value;
 }
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char ch : s) {
-    if (ch == '"') out += '"';
-    out += ch;
-  }
-  return out + "\"";
-}
-
-}  // namespace
 
 int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
   if (o.format != "table" && o.format != "csv" && o.format != "json")
@@ -202,7 +222,7 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
     for (const Filter& f : o.where) {
       auto it = t.rows[i].find(f.field);
       json v = it != t.rows[i].end() ? it->second : get_path(cases[i], f.field).value_or(json());
-      ok = ok && matches(v, f);
+      ok = ok && filter_matches(v, f);
     }
     if (ok) keep.push_back(i);
   }
@@ -274,7 +294,9 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
       auto it = t.rows[i].find(c);
       std::string cell = it == t.rows[i].end() ? "" : value_text(it->second);
       auto e = t.rows[i].find(c + "_err");
-      if (e != t.rows[i].end() && !e->second.is_null()) cell += " ± " + value_text(e->second);
+      if (e != t.rows[i].end() && !e->second.is_null() && it != t.rows[i].end() &&
+          it->second.is_number())
+        cell = format_with_error(it->second.get<double>(), e->second.get<double>());
       line.push_back(cell);
     }
     cells.push_back(line);

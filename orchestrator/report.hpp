@@ -1,5 +1,6 @@
 #pragma once
 // What `flocsim query` and `flocsim sweep status` print.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -18,6 +19,16 @@ struct Filter {
 };
 // Parses "phi>=0.2"; throws flocsim::input::InputError with the accepted forms.
 Filter parse_filter(const std::string& text);
+// Whether a value (a number, or text) satisfies the filter; numbers compare as
+// numbers, with equality to the last printed digits. Null never matches.
+bool filter_matches(const nlohmann::json& value, const Filter& filter);
+
+// A mean shown to the precision its standard error supports: the error
+// rounded to one significant digit and the mean to the same decimal place,
+// "0.304 ± 0.002" (not "0.303742 ± 0.00189871"). Without an error (or a zero
+// one) the mean is shown to 4 significant digits.
+std::string format_with_error(double mean, std::optional<double> error,
+                              const std::string& plus_minus = " ± ");
 
 struct QueryOptions {
   std::optional<std::string> sweep;  // restrict to one sweep

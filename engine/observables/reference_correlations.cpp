@@ -24,6 +24,16 @@ double beetstra_velocity_ratio(double phi, double reynolds_inf) {
   return 0.5 * (lo + hi);
 }
 
+double wylie_drag(double phi, double reynolds, double reynolds_t) {
+  const double base = beetstra_drag(phi, reynolds);
+  if (reynolds_t <= 0) return base;
+  const double x = reynolds_t / reynolds;
+  const double amplitude = reynolds * (0.0336 + 0.106 * phi + 0.0116 / std::pow(1 - phi, 5));
+  const double shape = (1 + 2 * x * x - x * x * x * x) * std::erf(1 / (std::sqrt(2.0) * x)) +
+                       std::sqrt(2 / M_PI) * x * (1 + x * x) * std::exp(-1 / (2 * x * x));
+  return base + amplitude * shape;
+}
+
 double richardson_zaki_exponent(double re) {
   if (re < 0.2) return 4.65;
   if (re < 1) return 4.35 * std::pow(re, -0.03);

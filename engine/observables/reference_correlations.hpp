@@ -19,6 +19,14 @@ double beetstra_drag(double phi, double reynolds);
 // spheres felt the drag of a static random array would settle at.
 double beetstra_velocity_ratio(double phi, double reynolds_inf);
 
+// Wylie, Koch & Ladd (2003) as the paper's eq. 5: the drag of spheres with
+// random velocity fluctuations (granular temperature T, Re_T = T^(1/2) 2a/nu)
+// on top of the mean slip, F(phi, Re, Re_T) = F(phi, Re, 0) + Re [0.0336 +
+// 0.106 phi + 0.0116/(1 - phi)^5] x [(1 + 2 x^2 - x^4) erf(1/(sqrt 2 x)) +
+// sqrt(2/pi) x (1 + x^2) exp(-1/(2 x^2))], x = Re_T / Re, with Beetstra's
+// drag (eq. 4) as F(phi, Re, 0), as the paper uses it. At Re_T = 0 it is eq. 4.
+double wylie_drag(double phi, double reynolds, double reynolds_t);
+
 // Richardson & Zaki (1954) hindered settling, U / U_inf = (1 - phi)^n with
 // n = 4.65 (Re < 0.2), 4.35 Re^-0.03 (0.2 <= Re < 1), 4.45 Re^-0.1
 // (1 <= Re < 500), 2.39 (Re >= 500), Re the single-sphere Re_inf. Settling

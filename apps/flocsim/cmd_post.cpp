@@ -1,0 +1,117 @@
+// flocsim post tables|figures|report --db F --out DIR: the paper's tables and
+// figures from a results database (docs/postprocess.md). Only reads the
+// database (also a read-only one, and one a running sweep is writing).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "apps/flocsim/command_registry.hpp"
+#include "db/results_db.hpp"
+#include "engine/input/input_reader.hpp"
+#include "postprocess/figures.hpp"
+#include "postprocess/report.hpp"
+#include "postprocess/tables.hpp"
+
+namespace flocsim::app {
+namespace {
+
+namespace fs = std::filesystem;
+namespace pp = flocsim::postprocess;
+
+struct PostOptions {
+  std::string db_path, out_dir, sweep;
+  std::vector<std::string> where;
+};
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream f(p);
+  f << text;
+  if (!f) throw std::runtime_error("cannot write " + p.string());
+}
+
+// Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table.
+void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out) {
+  const auto agg = pp::aggregation_table(runs);
+  const auto non = pp::non_aggregating_table(runs);
+  for (const std::string format : {"csv", "md", "tex"}) {
+    std::ostringstream a, n;
+    pp::write_aggregation(agg, format, a);
+    pp::write_non_aggregating(non, format, n);
+    write_file(out / ("aggregation." + format), a.str());
+    write_file(out / ("non_aggregating." + format), n.str());
+  }
+  write_file(out / "columns.md", pp::column_definitions());
+  std::ostringstream shown;
+  pp::write_aggregation(agg, "md", shown);
+  std::cout << "Aggregation: F/F0 against <n_a>/<n_a>0 (" << agg.size() << " runs with du > 0)\n\n"
+            << shown.str() << "\nNon-aggregating runs against Beetstra, Wylie and "
+            << "Richardson-Zaki: " << non.size() << " rows in "
+            << (out / "non_aggregating.md").string()
+            << "\nTables (CSV, Markdown, LaTeX) and their column definitions (columns.md) in "
+            << out.string() << "\n";
+}
+
+int post(const std::string& what, const PostOptions& o) {
+  try {
+    std::vector<orchestrator::Filter> where;
+    for (const std::string& w : o.where) where.push_back(orchestrator::parse_filter(w));
+    db::ResultsDb db(o.db_path, db::ResultsDb::Mode::kReadOnly);
+    const auto runs = pp::load_runs(
+        db, o.sweep.empty() ? std::nullopt : std::optional<std::string>(o.sweep), where);
+    const fs::path out(o.out_dir);
+    fs::create_directories(out);
+    if (what == "tables") {
+      write_tables(runs, out);
+    } else {
+      const pp::FigureSet figures = pp::write_figures(runs, out / "figures");
+      for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
+      for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
+      if (what == "report") {
+        write_tables(runs, out);
+        pp::write_report(runs, figures, o.db_path, out / "report.html");
+        std::cout << "report: " << (out / "report.html").string() << "\n";
+      } else {
+        std::cout << figures.figures.size() << " figures (PNG and PDF) in "
+                  << (out / "figures").string() << "\n";
+      }
+    }
+    return kExitOk;
+  } catch (const input::InputError& e) {
+    std::cerr << "flocsim post: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const db::DbError& e) {
+    std::cerr << "flocsim post: " << e.what() << "\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::cerr << "flocsim post: " << e.what() << "\n";
+    return kExitFailure;
+  }
+}
+
+const bool registered = register_command(
+    {"post", "The paper's tables, figures and an HTML report from a results database",
+     [](CLI::App& cmd) {
+       auto o = std::make_shared<PostOptions>();
+       auto what = std::make_shared<std::string>();
+       cmd.require_subcommand(1);
+       for (const auto& [name, help] :
+            {std::pair<std::string, std::string>{"tables",
+                                                 "F/F0 against <n_a>/<n_a>0 per run, and the "
+                                                 "non-aggregating drag against the correlations "
+                                                 "(CSV, Markdown, LaTeX)"},
+             {"figures", "The paper's figures where the data exist (PNG and PDF, gnuplot)"},
+             {"report", "One self-contained HTML page: tables, figures and provenance"}}) {
+         CLI::App* sub = cmd.add_subcommand(name, help);
+         sub->add_option("--db", o->db_path, "Results database")->required();
+         sub->add_option("--out,-o", o->out_dir, "Output folder")->required();
+         sub->add_option("--sweep", o->sweep, "Only the runs of this sweep");
+         sub->add_option("--where,-w", o->where, "Filter FIELD OP VALUE, as in flocsim query")
+             ->take_all();
+         sub->callback([what, name = name] { *what = name; });
+       }
+       return CommandHandler([o, what] { return post(*what, *o); });
+     }});
+
+}  // namespace
+}  // namespace flocsim::app

@@ -1,0 +1,392 @@
+#include "postprocess/tables.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "engine/input/input_reader.hpp"
+#include "engine/observables/reference_correlations.hpp"
+#include "orchestrator/sweep.hpp"
+
+namespace flocsim::postprocess {
+
+using json = nlohmann::json;
+
+namespace {
+
+std::optional<Measured> observable(const db::ResultsDb::ResultRow& r, const std::string& name) {
+  for (const db::Observable& o : r.observables)
+    if (o.name == name) return Measured{o.mean, o.error};
+  return std::nullopt;
+}
+
+double number_at(const json& j, const std::string& path, double fallback) {
+  const auto v = orchestrator::get_path(j, path);
+  return v && v->is_number() ? v->get<double>() : fallback;
+}
+
+// The case's identity with the attraction switched off: what its baseline has.
+std::string baseline_key(const json& case_json) {
+  json c = case_json;
+  c["du_over_Uinf"] = 0;
+  return orchestrator::canonical_text(c);
+}
+
+}  // namespace
+
+std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::string>& sweep,
+                                  const std::vector<orchestrator::Filter>& where) {
+  std::vector<db::SweepRecord> sweeps;
+  if (sweep) {
+    const auto s = db.find_sweep(*sweep);
+    if (!s) {
+      std::string known;
+      for (const auto& k : db.sweeps()) known += (known.empty() ? "" : ", ") + k.name;
+      throw input::InputError("--sweep " + *sweep + ": no such sweep in " + db.path() + " (" +
+                              (known.empty() ? "none" : known) + ")");
+    }
+    sweeps.push_back(*s);
+  } else {
+    sweeps = db.sweeps();
+  }
+  std::vector<RunSummary> out;
+  std::set<std::string> seen;
+  for (const db::SweepRecord& s : sweeps)
+    for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
+      if (!seen.insert(r.run.id).second) continue;  // a run shared by two sweeps: once
+      RunSummary u;
+      u.id = r.run.id;
+      u.status = r.run.status;
+      u.run_dir = r.run.run_dir;
+      u.sweep = s.name;
+      u.case_json = json::parse(r.run.case_json, nullptr, false);
+      if (!u.case_json.is_object()) continue;  // not a case this tool can read
+      u.phi = number_at(u.case_json, "phi", 0);
+      u.re_inf = number_at(u.case_json, "Re_inf", 0);
+      u.du = number_at(u.case_json, "du_over_Uinf", 0);
+      u.fidelity = u.case_json.value("fidelity", std::string("standard"));
+      u.has_result = r.has_result;
+      u.wall_s = r.wall_s;
+      u.flocsim_version = r.flocsim_version;
+      u.U_over_Uinf = observable(r, "U_over_Uinf");
+      u.F = observable(r, "F");
+      u.Re = observable(r, "Re");
+      u.Re_T = observable(r, "Re_T");
+      u.C_sph = observable(r, "C_sph");
+      u.n_a = observable(r, "n_a_mean");
+      if (!r.result_json.empty()) {
+        const json res = json::parse(r.result_json, nullptr, false);
+        if (res.is_object()) {
+          const json& obs = res.value("observables", json::object());
+          for (const char* name : {"U_over_Uinf", "F", "Re", "Re_T", "C_sph", "n_a_mean"})
+            if (obs.contains(name) && obs[name].is_object() &&
+                !obs[name].value("error_reliable", true))
+              u.errors_reliable = false;
+          for (const auto& n : res.value("not_stationary", json::array()))
+            if (n.is_string()) u.not_stationary.push_back(n.get<std::string>());
+          if (obs.contains("window") && obs["window"].is_object()) {
+            u.window_start = obs["window"].value("start", 0.0);
+            u.window_end = obs["window"].value("end", 0.0);
+          }
+          u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
+          if (u.phi == 0) u.phi = res["derived"].value("phi_realised", 0.0);
+        }
+      }
+      // the same filters as `flocsim query`: a case path, the status or an observable
+      bool keep = true;
+      for (const orchestrator::Filter& f : where) {
+        json v;
+        if (f.field == "status") {
+          v = u.status;
+        } else if (const auto c = orchestrator::get_path(u.case_json, f.field)) {
+          v = *c;
+        } else if (const auto o = observable(r, f.field)) {
+          v = o->mean;
+        }
+        keep = keep && orchestrator::filter_matches(v, f);
+      }
+      if (keep) out.push_back(std::move(u));
+    }
+  return out;
+}
+
+Measured ratio(const Measured& a, const Measured& b) {
+  Measured r{a.mean / b.mean, std::nullopt};
+  if (a.error && b.error)
+    r.error = std::abs(r.mean) * std::hypot(*a.error / a.mean, *b.error / b.mean);
+  return r;
+}
+
+std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs) {
+  std::map<std::string, std::vector<const RunSummary*>> zero_du;  // by case identity
+  for (const RunSummary& r : runs)
+    if (r.du == 0) zero_du[orchestrator::canonical_text(r.case_json)].push_back(&r);
+  std::vector<AggregationRow> rows;
+  for (const RunSummary& r : runs) {
+    if (r.du <= 0) continue;
+    AggregationRow row;
+    row.run = &r;
+    const auto it = zero_du.find(baseline_key(r.case_json));
+    const RunSummary* base = it == zero_du.end() ? nullptr : it->second.front();
+    if (r.status != "completed" || !r.F || !r.n_a) {
+      row.reason = "this run is " + r.status + (r.has_result ? " (no F or <n_a>)" : "");
+    } else if (!base) {
+      row.reason =
+          "no du = 0 run of the same case (same phi, Re_inf, fidelity, numerics, box, seed and "
+          "protocol) in the database";
+    } else if (base->status != "completed" || !base->F || !base->n_a) {
+      row.reason = "its baseline " + base->id.substr(0, 12) + " is " + base->status;
+    } else {
+      row.baseline = base;
+      row.F_over_F0 = ratio(*r.F, *base->F);
+      row.n_over_n0 = ratio(*r.n_a, *base->n_a);
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::vector<NonAggregatingRow> non_aggregating_table(const std::vector<RunSummary>& runs) {
+  std::vector<NonAggregatingRow> rows;
+  for (const RunSummary& r : runs) {
+    if (r.du != 0 || r.status != "completed" || !r.F || !r.Re) continue;
+    NonAggregatingRow row;
+    row.run = &r;
+    row.beetstra = observables::beetstra_drag(r.phi, r.Re->mean);
+    row.wylie = observables::wylie_drag(r.phi, r.Re->mean, r.Re_T ? r.Re_T->mean : 0.0);
+    row.richardson_zaki = observables::richardson_zaki_velocity_ratio(r.phi, r.re_inf);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+namespace {
+
+// A cell writer for the three formats: CSV keeps full precision with the
+// error in its own column, Markdown and LaTeX round a mean to its error.
+struct Writer {
+  std::string format;
+  std::ostream& out;
+  std::vector<std::string> cells;
+
+  static std::string number(double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.10g", v);
+    return b;
+  }
+  void text(const std::string& s) { cells.push_back(s); }
+  void value(double v, int digits = 4) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.*g", digits, v);
+    cells.push_back(format == "csv" ? number(v) : b);
+  }
+  void measured(const std::optional<Measured>& m) {
+    if (format == "csv") {
+      cells.push_back(m ? number(m->mean) : "");
+      cells.push_back(m && m->error ? number(*m->error) : "");
+      return;
+    }
+    cells.push_back(
+        m ? orchestrator::format_with_error(m->mean, m->error, format == "tex" ? " \\pm " : " ± ")
+          : "");
+    if (format == "tex" && m) cells.back() = "$" + cells.back() + "$";
+  }
+  void header(const std::vector<std::string>& names, const std::vector<bool>& with_error) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      cells.push_back(names[i]);
+      if (format == "csv" && with_error[i]) cells.push_back(names[i] + "_err");
+    }
+    if (format == "tex") {
+      out << "\\begin{tabular}{" << std::string(cells.size(), 'l') << "}\n\\toprule\n";
+    }
+    end_row();
+    if (format == "md") {
+      out << "|";
+      for (std::size_t i = 0; i < names.size(); ++i) out << "---|";
+      out << "\n";
+    }
+    if (format == "tex") out << "\\midrule\n";
+  }
+  void end_row() {
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      std::string c = cells[i];
+      if (format == "csv" && c.find_first_of(",\"\n") != std::string::npos) {
+        std::string q = "\"";
+        for (char ch : c) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+        c = q + "\"";
+      }
+      if (format == "tex") {
+        std::string e;
+        for (char ch : c)
+          e += (ch == '_' || ch == '%' || ch == '&' || ch == '#') ? std::string("\\") + ch
+                                                                  : std::string(1, ch);
+        if (c.size() > 1 && c.front() == '$') e = c;  // already math
+        c = e;
+      }
+      if (format == "md")
+        out << (i ? " | " : "| ") << c;
+      else if (format == "tex")
+        out << (i ? " & " : "") << c;
+      else
+        out << (i ? "," : "") << c;
+    }
+    if (format == "md") out << " |";
+    if (format == "tex") out << " \\\\";
+    out << "\n";
+    cells.clear();
+  }
+  void finish() {
+    if (format == "tex") out << "\\bottomrule\n\\end{tabular}\n";
+  }
+};
+
+std::string yes_no(bool b) {
+  return b ? "yes" : "no";
+}
+
+std::string stationary_text(const RunSummary& r) {
+  if (r.not_stationary.empty()) return "yes";
+  std::string s = "no:";
+  for (const auto& n : r.not_stationary) s += " " + n;
+  return s;
+}
+
+std::string window_text(const RunSummary& r) {
+  if (r.window_end <= r.window_start) return "";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.0f-%.0f", r.window_start, r.window_end);
+  return b;
+}
+
+}  // namespace
+
+void write_aggregation(const std::vector<AggregationRow>& rows, const std::string& format,
+                       std::ostream& out) {
+  Writer w{format, out, {}};
+  w.header({"phi",
+            "Re_inf",
+            "du_over_Uinf",
+            "Re",
+            "F",
+            "F0",
+            "F_over_F0",
+            "n_a",
+            "n_a0",
+            "n_a_over_n_a0",
+            "U_over_Uinf",
+            "C_sph",
+            "Re_T",
+            "window",
+            "N",
+            "errors_reliable",
+            "stationary",
+            "run",
+            "baseline",
+            "note"},
+           {false, false, false, true,  true,  true,  true,  true,  true,  true,
+            true,  true,  true,  false, false, false, false, false, false, false});
+  for (const AggregationRow& row : rows) {
+    const RunSummary& r = *row.run;
+    const RunSummary* b = row.baseline;
+    w.value(r.phi, 3);
+    w.value(r.re_inf, 3);
+    w.value(r.du, 3);
+    w.measured(r.Re);
+    w.measured(r.F);
+    w.measured(b ? b->F : std::nullopt);
+    w.measured(row.F_over_F0);
+    w.measured(r.n_a);
+    w.measured(b ? b->n_a : std::nullopt);
+    w.measured(row.n_over_n0);
+    w.measured(r.U_over_Uinf);
+    w.measured(r.C_sph);
+    w.measured(r.Re_T);
+    w.text(window_text(r));
+    w.text(r.sphere_count ? std::to_string(r.sphere_count) : "");
+    w.text(b ? yes_no(r.errors_reliable && b->errors_reliable) : yes_no(r.errors_reliable));
+    w.text(b && !b->not_stationary.empty()
+               ? stationary_text(r) + "; baseline " + stationary_text(*b)
+               : stationary_text(r));
+    w.text(r.id.substr(0, 12));
+    w.text(b ? b->id.substr(0, 12) : "");
+    w.text(row.reason);
+    w.end_row();
+  }
+  w.finish();
+}
+
+void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std::string& format,
+                           std::ostream& out) {
+  Writer w{format, out, {}};
+  w.header({"phi", "Re_inf", "Re", "F", "Re_T", "F_Beetstra", "dev_Beetstra_pct", "F_Wylie",
+            "dev_Wylie_pct", "U_over_Uinf", "U_over_Uinf_RZ", "dev_RZ_pct", "window", "N",
+            "errors_reliable", "stationary", "run"},
+           {false, false, true, true, true, false, false, false, false, true, false, false, false,
+            false, false, false, false});
+  for (const NonAggregatingRow& row : rows) {
+    const RunSummary& r = *row.run;
+    w.value(r.phi, 3);
+    w.value(r.re_inf, 3);
+    w.measured(r.Re);
+    w.measured(r.F);
+    w.measured(r.Re_T);
+    w.value(row.beetstra);
+    w.value(100 * (r.F->mean / row.beetstra - 1), 3);
+    w.value(row.wylie);
+    w.value(100 * (r.F->mean / row.wylie - 1), 3);
+    w.measured(r.U_over_Uinf);
+    w.value(row.richardson_zaki);
+    if (r.U_over_Uinf)
+      w.value(100 * (r.U_over_Uinf->mean / row.richardson_zaki - 1), 3);
+    else
+      w.text("");
+    w.text(window_text(r));
+    w.text(r.sphere_count ? std::to_string(r.sphere_count) : "");
+    w.text(yes_no(r.errors_reliable));
+    w.text(stationary_text(r));
+    w.text(r.id.substr(0, 12));
+    w.end_row();
+  }
+  w.finish();
+}
+
+std::string column_definitions() {
+  return R"(# Columns of the flocsim post tables
+
+All quantities are dimensionless (paper section 2 and docs/model.md).
+
+| column | meaning |
+|---|---|
+| phi | solids volume fraction of the case |
+| Re_inf | single-sphere settling Reynolds number U_inf 2a / nu (input) |
+| du_over_Uinf | square-well strength: escape velocity over U_inf (input) |
+| Re | U 2a / nu, U the superficial slip velocity (1 - phi)(<u> - <u_p>) |
+| F | drag per sphere F_h / (6 pi rho nu a U), F_h = f (4/3) pi a^3 (1/phi - 1) |
+| F0 | F of the baseline: the same case with du_over_Uinf = 0 |
+| F_over_F0 | F / F0 |
+| n_a | mass-weighted mean aggregate size <n_a> (spheres within 2(a + delta) are bonded) |
+| n_a0 | <n_a> of the baseline (du = 0: clusters of spheres that merely touch) |
+| n_a_over_n_a0 | <n_a> / <n_a>0 |
+| U_over_Uinf | U / U_inf |
+| C_sph | contacts per sphere: other centres within 2(a + delta) |
+| Re_T | T^(1/2) 2a / nu, T the granular temperature |
+| window | statistics window, t U_inf / a |
+| N | number of spheres |
+| errors_reliable | every batch of the batch-means errors spans at least 5 correlation times (for the pair: in both runs) |
+| stationary | "yes", or "no:" with the observables whose window still drifts (|z| > 3 on a fitted trend) |
+| F_Beetstra | Beetstra et al. (2007), paper eq. 4, at the run's phi and Re (static random arrays) |
+| F_Wylie | Wylie et al. (2003), paper eq. 5, at the run's phi, Re and Re_T |
+| U_over_Uinf_RZ | Richardson-Zaki (1 - phi)^n, n from Re_inf |
+| dev_*_pct | 100 (measured / reference - 1) |
+| run, baseline | the first 12 hex digits of the runs' ids (flocsim query shows them) |
+| note | why a run has no F/F0: it did not complete, or has no usable baseline |
+
+Errors (CSV columns *_err, "±" elsewhere) are batch-means standard errors of the mean. A ratio
+r = a / b of two runs carries e_r = |r| sqrt((e_a / a)^2 + (e_b / b)^2): first-order propagation
+for independent runs. Markdown and LaTeX show each mean rounded to its error's first significant
+digit; CSV keeps full precision.
+)";
+}
+
+}  // namespace flocsim::postprocess

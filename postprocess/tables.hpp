@@ -1,0 +1,79 @@
+#pragma once
+// The science from a results database (paper section 4.4): the drag per
+// sphere of an aggregating suspension relative to the same suspension without
+// attraction, F/F0, against the normalised mean aggregate size <n_a>/<n_a>0,
+// and the non-aggregating drag against the published correlations.
+//
+// A run with du/U_inf > 0 is paired with its baseline: the run whose canonical
+// case is identical but for du_over_Uinf = 0 (same phi, Re_inf, fidelity,
+// numerics, box, seed, protocol). Nothing else is ever paired, and a run
+// without a usable baseline is listed with the reason, never dropped.
+//
+// Errors: each mean carries its batch-means standard error; a ratio r = a/b of
+// two independent runs carries e_r = |r| sqrt((e_a/a)^2 + (e_b/b)^2) (first
+// order). docs/postprocess.md.
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "db/results_db.hpp"
+#include "orchestrator/report.hpp"
+
+namespace flocsim::postprocess {
+
+// A mean with its standard error (absent for plain numbers or missing data).
+struct Measured {
+  double mean = 0;
+  std::optional<double> error;
+};
+
+// One run of the database, with what the tables need from its result.json.
+struct RunSummary {
+  std::string id, status, run_dir, sweep;
+  nlohmann::json case_json;  // canonical case
+  bool has_result = false;
+  std::optional<Measured> U_over_Uinf, F, Re, Re_T, C_sph, n_a;
+  bool errors_reliable = true;  // every error in the table's observables is
+  std::vector<std::string> not_stationary;
+  double window_start = 0, window_end = 0;  // statistics window, t U_inf / a
+  int sphere_count = 0;
+  double phi = 0, re_inf = 0, du = 0;
+  std::optional<double> wall_s;
+  std::string flocsim_version, fidelity;
+};
+
+// The runs of the database (of one sweep when given), filtered like `flocsim
+// query --where`, in grid order.
+std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::string>& sweep,
+                                  const std::vector<orchestrator::Filter>& where);
+
+// r = a / b with its first-order error for independent a and b.
+Measured ratio(const Measured& a, const Measured& b);
+
+struct AggregationRow {
+  const RunSummary* run = nullptr;
+  const RunSummary* baseline = nullptr;  // null: see reason
+  std::string reason;                    // why there is no pairing (empty when paired)
+  std::optional<Measured> F_over_F0, n_over_n0;
+};
+// One row per run with du/U_inf > 0, paired where a completed baseline exists.
+std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs);
+
+struct NonAggregatingRow {
+  const RunSummary* run = nullptr;
+  double beetstra = 0, wylie = 0, richardson_zaki = 0;  // F, F, U/U_inf
+};
+// One row per completed run with du/U_inf = 0.
+std::vector<NonAggregatingRow> non_aggregating_table(const std::vector<RunSummary>& runs);
+
+// The tables in the formats of `flocsim post tables`; `format` is csv, md or tex.
+void write_aggregation(const std::vector<AggregationRow>& rows, const std::string& format,
+                       std::ostream& out);
+void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std::string& format,
+                           std::ostream& out);
+// Definitions and units of every column (the CSV files' sidecar).
+std::string column_definitions();
+
+}  // namespace flocsim::postprocess

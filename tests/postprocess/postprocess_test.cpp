@@ -1,0 +1,253 @@
+// flocsim post: the aggregation table against a hand calculation on a database
+// written through db/'s API, the pairing rule (never across numerics, missing
+// baselines listed with their reason), rounding to the error, the reference
+// correlations against hand-computed values, and figures that gnuplot really
+// drew.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "db/results_db.hpp"
+#include "engine/input/input_reader.hpp"
+#include "engine/observables/reference_correlations.hpp"
+#include "engine/output/hdf5_file.hpp"
+#include "orchestrator/report.hpp"
+#include "orchestrator/sweep.hpp"
+#include "postprocess/figures.hpp"
+#include "postprocess/report.hpp"
+#include "postprocess/tables.hpp"
+
+namespace flocsim::postprocess {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using ::testing::HasSubstr;
+
+struct HandRun {
+  std::string id;
+  json case_json;
+  std::string state;  // completed | failed | running | pending
+  double F = 0, F_err = 0, n_a = 0, n_a_err = 0;
+};
+
+json suspension(double du, double re_inf = 12, double a = 4) {
+  return orchestrator::canonical(json{{"scene", "suspension"},
+                                      {"fidelity", "draft"},
+                                      {"phi", 0.2},
+                                      {"Re_inf", re_inf},
+                                      {"du_over_Uinf", du},
+                                      {"numerics", {{"a_over_dx", a}}}});
+}
+
+class Post : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("flocsim_post_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  // Writes the runs through db/'s API as the orchestrator would.
+  std::string write_db(const std::vector<HandRun>& runs, bool with_series = false) {
+    const std::string path = (dir_ / "results.db").string();
+    db::ResultsDb db(path, db::ResultsDb::Mode::kCreate);
+    const auto sweep = db.upsert_sweep("hand", "{}", "[\"du_over_Uinf\"]", 2);
+    std::vector<db::ResultsDb::NewRun> news;
+    for (const HandRun& r : runs)
+      news.push_back({r.id, orchestrator::canonical_text(r.case_json), (dir_ / r.id).string(),
+                      json{{"du_over_Uinf", r.case_json["du_over_Uinf"]}}.dump()});
+    db.add_runs(sweep, news);
+    db::AttemptStart start;
+    start.host = "test";
+    start.owner_pid = getpid();
+    for (const HandRun& r : runs) {
+      if (r.state == "pending") continue;
+      db::ClaimRequest req;
+      req.sweep_id = sweep;
+      req.states = {"pending"};
+      req.run_id = r.id;
+      const auto claim = db.claim_run(req, start);
+      if (r.state == "failed")
+        db.end_attempt(claim->attempt_id, "failed", 1, std::nullopt, "blew up");
+      if (r.state != "completed") continue;
+      db::ResultRecord rec;
+      rec.run_id = r.id;
+      rec.flocsim_version = "test";
+      rec.completed_at = "now";
+      rec.wall_s = 10;
+      json obs = {{"F", {{"mean", r.F}, {"error", r.F_err}, {"error_reliable", true}}},
+                  {"n_a_mean", {{"mean", r.n_a}, {"error", r.n_a_err}, {"error_reliable", true}}},
+                  {"window", {{"start", 100}, {"end", 400}}}};
+      rec.result_json = json{{"observables", obs},
+                             {"not_stationary", json::array()},
+                             {"derived", {{"sphere_count", 49}}}}
+                            .dump();
+      rec.observables = {{"F", r.F, r.F_err}, {"n_a_mean", r.n_a, r.n_a_err}, {"Re", 4.0, 0.1},
+                         {"Re_T", 1.0, 0.05}, {"U_over_Uinf", 0.3, 0.01},     {"C_sph", 1.0, 0.1}};
+      db.record_result(claim->attempt_id, rec);
+      if (with_series) write_series(dir_ / r.id, r.case_json["du_over_Uinf"].get<double>());
+    }
+    return path;
+  }
+
+  // A small series.h5 of the layout the solver writes.
+  static void write_series(const fs::path& dir, double du) {
+    fs::create_directories(dir);
+    output::Hdf5File f(dir / "series.h5", output::Hdf5File::Mode::create);
+    std::vector<double> t, stage, u, c, phi_x;
+    for (int k = 0; k < 50; ++k) {
+      t.push_back(k);
+      stage.push_back(k < 20 ? 1 : 2);
+      u.push_back(0.3 + du * k / 50);
+      c.push_back(0.5 + 10 * du * k / 50);
+      for (int s = 0; s < 8; ++s) phi_x.push_back(0.2 + 0.01 * std::sin(0.3 * k + s));
+    }
+    f.write("/time", {t.size()}, t.data());
+    f.write("/stage", {t.size()}, stage.data());
+    f.write("/U_over_Uinf", {t.size()}, u.data());
+    f.write("/C_sph", {t.size()}, c.data());
+    f.write("/phi_x", {50, 8}, phi_x.data());
+    f.create_group("/distributions");
+    std::vector<double> p = {0, 0.5, 0.3, 0.1, 0.1}, r = {2, 2.5, 3}, g = {3, 1.2, 1},
+                        th = {0.5, 1.5}, h = {1.1, 0.9};
+    f.write("/distributions/size_distribution", {p.size()}, p.data());
+    f.write("/distributions/r_over_a", {r.size()}, r.data());
+    f.write("/distributions/g", {g.size()}, g.data());
+    f.write("/distributions/theta", {th.size()}, th.data());
+    f.write("/distributions/h", {h.size()}, h.data());
+    f.close();
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Post, AggregationTableEqualsAHandCalculation) {
+  // Baseline F0 = 4.0 +- 0.12, <n_a>0 = 2.0 +- 0.1; du = 0.02: F = 3.0 +- 0.09,
+  // <n_a> = 8.0 +- 0.4. By hand: F/F0 = 0.75 with 0.75 sqrt(0.03^2 + 0.03^2)
+  // = 0.0318198; <n_a>/<n_a>0 = 4 with 4 sqrt(0.05^2 + 0.05^2) = 0.2828427.
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4}});
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  const auto rows = aggregation_table(runs);
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_NE(rows[0].baseline, nullptr) << rows[0].reason;
+  EXPECT_EQ(rows[0].baseline->id, "base");
+  EXPECT_NEAR(rows[0].F_over_F0->mean, 0.75, 1e-14);
+  EXPECT_NEAR(*rows[0].F_over_F0->error, 0.0318198052, 1e-9);
+  EXPECT_NEAR(rows[0].n_over_n0->mean, 4.0, 1e-14);
+  EXPECT_NEAR(*rows[0].n_over_n0->error, 0.2828427125, 1e-9);
+  std::ostringstream md, csv, tex;
+  write_aggregation(rows, "md", md);
+  write_aggregation(rows, "csv", csv);
+  write_aggregation(rows, "tex", tex);
+  EXPECT_THAT(md.str(), HasSubstr("| 0.75 ± 0.03 |"));  // rounded to the error
+  EXPECT_THAT(md.str(), HasSubstr("| 4.0 ± 0.3 |"));
+  EXPECT_THAT(csv.str(), HasSubstr(",0.75,0.03181980515,"));  // full precision in CSV
+  EXPECT_THAT(tex.str(), HasSubstr("$0.75 \\pm 0.03$"));
+  EXPECT_THAT(tex.str(), HasSubstr("\\toprule"));
+}
+
+TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {
+  const std::string db_path = write_db({
+      {"b8", suspension(0, 12, 8), "completed", 4.0, 0.1, 2.0, 0.1},     // du = 0 at a = 8
+      {"a6", suspension(0.03, 12, 6), "completed", 3.0, 0.1, 9.0, 0.5},  // a = 6: no baseline
+      {"f24", suspension(0, 24), "failed"},                              // a failed baseline
+      {"a24", suspension(0.01, 24), "completed", 3.5, 0.1, 3.0, 0.2},
+      {"run", suspension(0.02, 24), "running"},  // still running
+  });
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  const auto rows = aggregation_table(runs);
+  ASSERT_EQ(rows.size(), 3u);  // every run with du > 0 is listed
+  std::map<std::string, std::string> reason;
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.baseline, nullptr) << r.run->id;
+    reason[r.run->id] = r.reason;
+  }
+  EXPECT_THAT(reason["a6"], HasSubstr("no du = 0 run of the same case"));
+  EXPECT_THAT(reason["a24"], HasSubstr("baseline f24 is failed"));
+  EXPECT_THAT(reason["run"], HasSubstr("this run is running"));
+  // a filter as in flocsim query
+  const auto only24 = load_runs(db, std::nullopt, {orchestrator::parse_filter("Re_inf=24")});
+  EXPECT_EQ(only24.size(), 3u);
+  EXPECT_THROW(load_runs(db, std::string("nosuch"), {}), input::InputError);
+}
+
+TEST(RoundToError, OneSignificantDigitOfTheError) {
+  using orchestrator::format_with_error;
+  EXPECT_EQ(format_with_error(0.303742, 0.00189871), "0.304 ± 0.002");
+  EXPECT_EQ(format_with_error(6, 0.5), "6.0 ± 0.5");
+  EXPECT_EQ(format_with_error(12345, 678), "12300 ± 700");
+  EXPECT_EQ(format_with_error(0.0963, 0.0096), "0.10 ± 0.01");  // 0.0096 rounds to 0.01
+  EXPECT_EQ(format_with_error(3.14159, std::nullopt), "3.142");
+}
+
+TEST(ReferenceCurves, AgainstHandComputedValues) {
+  // Beetstra eq. 4 at phi = 0.2, Re = 4: Stokes part 10 * 0.2 / 0.64 + 0.64 (1 + 1.5
+  // sqrt 0.2) = 3.125 + 1.069325 = 4.194325; inertial part 0.413 * 4 / (24 * 0.64) = 0.107552
+  // times (1.25 + 0.48 + 8.4 * 4^-0.343 = 6.951229) over (1 + 10^0.6 * 4^-0.9 = 2.143263)
+  // = 0.348823; total 4.543148.
+  EXPECT_NEAR(observables::beetstra_drag(0.2, 4), 4.543148, 2e-6);
+  // Wylie eq. 5 at Re_T = 1: x = 0.25, amplitude 4 (0.0336 + 0.0212 + 0.0116 / 0.8^5)
+  // = 0.360800; shape (1 + 0.125 - 0.00390625) erf(2.828427) + sqrt(2/pi) 0.25
+  // (1.0625) exp(-8) = 1.121094; so F = Beetstra + 0.404491.
+  EXPECT_NEAR(observables::wylie_drag(0.2, 4, 1) - observables::beetstra_drag(0.2, 4), 0.404491,
+              2e-6);
+  EXPECT_EQ(observables::wylie_drag(0.2, 4, 0), observables::beetstra_drag(0.2, 4));
+  // Richardson-Zaki at Re_inf = 0.1 (n = 4.65): 0.8^4.65 = exp(4.65 * -0.2231436) =
+  // exp(-1.0376176) = 0.367879 * 0.963081 = 0.354298
+  EXPECT_NEAR(observables::richardson_zaki_velocity_ratio(0.2, 0.1), 0.354298, 2e-6);
+}
+
+bool starts_with(const fs::path& file, const std::string& magic) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(magic.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return head == magic;
+}
+
+TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4},
+                {"agg3", suspension(0.03), "completed", 2.8, 0.09, 12.0, 0.6}},
+               /*with_series=*/true);
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  const FigureSet set = write_figures(runs, dir_ / "figures");
+  std::set<std::string> names;
+  for (const Figure& f : set.figures) {
+    names.insert(f.name);
+    EXPECT_TRUE(starts_with(f.png, "\x89PNG\r\n\x1a\n")) << f.png;
+    EXPECT_TRUE(starts_with(f.pdf, "%PDF")) << f.pdf;
+    EXPECT_GT(fs::file_size(f.png), 5000u) << f.png;  // drawn, not an empty canvas
+    EXPECT_GT(fs::file_size(f.pdf), 3000u) << f.pdf;
+  }
+  for (const char* want :
+       {"drag_vs_Re", "ReT_vs_Re", "timeseries_phi0.2_Re12", "size_distribution_phi0.2_Re12",
+        "pair_structure_phi0.2_Re12", "spacetime_phi0.2_Re12_du0.02", "n_a_vs_du",
+        "drag_vs_Re_per_du", "drag_ratio_vs_size_ratio"})
+    EXPECT_TRUE(names.count(want)) << want;
+  write_report(runs, set, db_path, dir_ / "report.html");
+  std::ifstream in(dir_ / "report.html");
+  std::stringstream html;
+  html << in.rdbuf();
+  EXPECT_THAT(html.str(), HasSubstr("data:image/png;base64,iVBORw0KGgo"));  // an embedded PNG
+  EXPECT_THAT(html.str(), HasSubstr("0.75 ± 0.03"));
+  EXPECT_THAT(html.str(), HasSubstr("<td>completed</td>"));
+}
+
+}  // namespace
+}  // namespace flocsim::postprocess
