@@ -141,7 +141,8 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       plots += (plots.empty() ? "" : ", ") + p.data("phi" + num(phi), rows.str()) + " " + kPoint +
                " lc " + std::to_string(plots.size() % 7 + 1) + " title 'phi = " + num(phi) + "'";
       plots += ", " + p.data("wylie_phi" + num(phi), wylie.str()) +
-               " with points pt 10 ps 1.4 lc rgb 'gray30' notitle";
+               " with points pt 10 ps 1.4 lc rgb 'gray30' title 'Wylie eq. 5, phi = " + num(phi) +
+               "'";
       plots += ", 10*" + num(phi) + "/(1-" + num(phi) + ")**2 + (1-" + num(phi) +
                ")**2*(1+1.5*sqrt(" + num(phi) + ")) + 0.413*x/(24*(1-" + num(phi) + ")**2)*(1/(1-" +
                num(phi) + ")+3*" + num(phi) + "*(1-" + num(phi) + ")+8.4*x**(-0.343))/(1+10**(3*" +
@@ -201,7 +202,9 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                  "well is switched on (Figs. 5, 7)");
       std::string top, bottom;
       for (const auto& [r, s] : members) {
-        double t0 = s.time.front();
+        // without a well there is no switch: its statistics start where stage 1
+        // was found stationary, the moment the others switch the well on
+        double t0 = r->window_end > r->window_start ? r->window_start : s.time.front();
         for (std::size_t k = 0; k < s.stage.size(); ++k)
           if (s.stage[k] >= 2) {
             t0 = s.time[k];
@@ -213,12 +216,12 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                << num(k < s.C_sph.size() ? s.C_sph[k] : 0) << "\n";
         const std::string file = p.data("du" + num(r->du) + "_" + r->id.substr(0, 8), rows.str());
         top += (top.empty() ? "" : ", ") + file +
-               " using 1:2 with lines lw 2 title 'du/U_inf = " + num(r->du) + "'";
+               " using 1:2 with lines lw 2 title 'du/U_{inf} = " + num(r->du) + "'";
         bottom += (bottom.empty() ? "" : ", ") + file +
-                  " using 1:3 with lines lw 2 title 'du/U_inf = " + num(r->du) + "'";
+                  " using 1:3 with lines lw 2 title 'du/U_{inf} = " + num(r->du) + "'";
       }
-      p.commands() << "set multiplot layout 2,1\nset grid\nset xlabel 't U_inf / a'\nset ylabel "
-                      "'U/U_inf'\nset key left top\nplot "
+      p.commands() << "set multiplot layout 2,1\nset grid\nset xlabel 't U_{inf} / a'\nset ylabel "
+                      "'U/U_{inf}'\nset key left top\nplot "
                    << top << "\nset ylabel 'C_{sph}'\nplot " << bottom << "\nunset multiplot\n";
       set.figures.push_back(p.render("900,800", "6in,5.4in"));
     }
@@ -235,7 +238,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
         if (rows.str().empty()) continue;
         plots += (plots.empty() ? "" : ", ") +
                  p.data("du" + num(r->du) + "_" + r->id.substr(0, 8), rows.str()) +
-                 " with linespoints pt 7 title 'du/U_inf = " + num(r->du) + "'";
+                 " with linespoints pt 7 title 'du/U_{inf} = " + num(r->du) + "'";
       }
       if (!plots.empty()) {
         p.commands() << "set logscale xy\nset grid\nset xlabel 'n_a'\nset ylabel 'p(n_a)'\nplot "
@@ -259,9 +262,9 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
           h << num(s.theta[k]) << " " << num(s.h[k]) << "\n";
         const std::string t = "du" + num(r->du) + "_" + r->id.substr(0, 8);
         top += (top.empty() ? "" : ", ") + p.data("g_" + t, g.str()) +
-               " with lines lw 2 title 'du/U_inf = " + num(r->du) + "'";
+               " with lines lw 2 title 'du/U_{inf} = " + num(r->du) + "'";
         bottom += (bottom.empty() ? "" : ", ") + p.data("h_" + t, h.str()) +
-                  " with lines lw 2 title 'du/U_inf = " + num(r->du) + "'";
+                  " with lines lw 2 title 'du/U_{inf} = " + num(r->du) + "'";
       }
       if (!top.empty()) {
         p.commands() << "set multiplot layout 2,1\nset grid\nset xlabel 'r/a'\nset ylabel "
@@ -287,7 +290,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       }
       // a colour scale symmetric about zero: white is the mean solids fraction
       const std::string file = p.data("", rows.str());
-      p.commands() << "set xlabel 't U_inf / a'\nset ylabel 'x / L'\nset cblabel "
+      p.commands() << "set xlabel 't U_{inf} / a'\nset ylabel 'x / L'\nset cblabel "
                       "'phi(x,t) - phi'\nset palette defined (-1 'blue', 0 'white', 1 'red')\n"
                       "stats "
                    << file
@@ -313,12 +316,12 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                  << "\n";
         if (rows.str().empty()) continue;
         plots += (plots.empty() ? "" : ", ") + p.data(label(phi, re), rows.str()) + " " + kPoint +
-                 " title 'phi = " + num(phi) + ", Re_inf = " + num(re) + "'";
+                 " title 'phi = " + num(phi) + ", Re_{inf} = " + num(re) + "'";
       }
     if (dus.size() < 2 || plots.empty()) {
       set.skipped.push_back("n_a_vs_du: fewer than two values of du/U_inf");
     } else {
-      p.commands() << "set xlabel 'du/U_inf'\nset ylabel '<n_a>'\nset logscale y\nset grid\nset "
+      p.commands() << "set xlabel 'du/U_{inf}'\nset ylabel '<n_a>'\nset logscale y\nset grid\nset "
                       "key left top\nplot "
                    << plots << "\n";
       set.figures.push_back(p.render());
@@ -336,7 +339,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                << "\n";
       plots += (plots.empty() ? "" : ", ") + p.data("du" + num(du), rows.str()) +
                " with yerrorbars pt " + std::to_string(style++) +
-               " ps 1.3 title 'du/U_inf = " + num(du) + "'";
+               " ps 1.3 title 'du/U_{inf} = " + num(du) + "'";
     }
     if (plots.empty()) {
       set.skipped.push_back("drag_vs_Re_per_du: no completed run");
@@ -368,7 +371,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
         for (const auto& [re, rows] : per_re)
           plots += (plots.empty() ? "" : ", ") + p.data(label(phi, re), rows) +
                    " with xyerrorbars pt " + std::to_string(style++) +
-                   " ps 1.3 title 'Re_inf = " + num(re) + "'";
+                   " ps 1.3 title 'Re_{inf} = " + num(re) + "'";
         p.commands() << "set title 'phi = " << num(phi) << "'\nplot " << plots << "\n";
       }
       p.commands() << "unset multiplot\n";

@@ -65,16 +65,18 @@ int post(const std::string& what, const PostOptions& o) {
       write_tables(runs, out);
     } else {
       const pp::FigureSet figures = pp::write_figures(runs, out / "figures");
-      for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
+      if (what == "figures")
+        for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
       for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
       if (what == "report") {
         write_tables(runs, out);
         pp::write_report(runs, figures, o.db_path, out / "report.html");
-        std::cout << "report: " << (out / "report.html").string() << "\n";
-      } else {
-        std::cout << figures.figures.size() << " figures (PNG and PDF) in "
-                  << (out / "figures").string() << "\n";
       }
+      std::cout << figures.figures.size() << " figures (PNG and PDF, with their data and gnuplot "
+                << "scripts) in " << (out / "figures").string() << "\n";
+      if (what == "report")
+        std::cout << "Report (tables, figures, provenance; one file): "
+                  << (out / "report.html").string() << "\n";
     }
     return kExitOk;
   } catch (const input::InputError& e) {
