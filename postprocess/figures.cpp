@@ -48,7 +48,12 @@ class Plot {
     Figure f{name_, caption_, dir_ / (name_ + ".png"), dir_ / (name_ + ".pdf")};
     const fs::path script = dir_ / "scripts" / (name_ + ".gp");
     std::ofstream(script) << "set terminal pngcairo size " << size_png
-                          << " enhanced font 'sans,11'\nset output '" << f.png.string() << "'\n"
+                          << " enhanced font 'sans,11'\nset output '" << f.png.string()
+                          << "'\n"
+                          // keep symbols off the frame (not for maps, which fill it)
+                          << (name_.rfind("spacetime", 0) == 0
+                                  ? ""
+                                  : "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n")
                           << commands_.str() << "\nset terminal pdfcairo size " << size_pdf
                           << " enhanced font 'sans,9'\nset output '" << f.pdf.string()
                           << "'\nreplot\nunset output\n";

@@ -185,6 +185,31 @@ TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {
   EXPECT_THROW(load_runs(db, std::string("nosuch"), {}), input::InputError);
 }
 
+TEST_F(Post, SeveralSweepsInOneDatabase) {
+  // a second sweep shares the baseline and adds a run of its own: every run once, and
+  // --sweep selects one sweep's runs
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4}});
+  {
+    db::ResultsDb db(db_path, db::ResultsDb::Mode::kExisting);
+    const auto other = db.upsert_sweep("other", "{}", "[]", 2);
+    db.add_runs(
+        other,
+        {{"base", orchestrator::canonical_text(suspension(0)), (dir_ / "base").string(), "{}"},
+         {"new", orchestrator::canonical_text(suspension(0.01)), (dir_ / "new").string(), "{}"}});
+  }
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto all = load_runs(db, std::nullopt, {});
+  EXPECT_EQ(all.size(), 3u);
+  const auto rows = aggregation_table(all);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& r : rows)
+    if (r.run->id == "new") EXPECT_THAT(r.reason, HasSubstr("this run is pending"));
+  const auto other = load_runs(db, std::string("other"), {});
+  EXPECT_EQ(other.size(), 2u);
+}
+
 TEST(RoundToError, OneSignificantDigitOfTheError) {
   using orchestrator::format_with_error;
   EXPECT_EQ(format_with_error(0.303742, 0.00189871), "0.304 ± 0.002");
