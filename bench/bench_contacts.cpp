@@ -94,7 +94,8 @@ Figures run_case(int n, int reps, int steps, double speed_scale) {
   for (int k = 0; k < 200; ++k) model.apply(s, rng);  // fluctuations at their stationary level
   events::DirectInteractions contacts({.escape_velocity = 0.0, .well_width = 0.025 * kA});
   const lubrication::RadialLubrication lub({.viscosity = kNu});
-  // Start-up as in SPEC: no well first, then switched on with pairs inside bound.
+  // Start-up as in the run protocol (docs/model.md section 3): no well first, then switched on with
+  // pairs inside bound.
   for (int k = 0; k < 100; ++k) {
     model.apply(s, rng);
     contacts.advance(s, box, 1.0);

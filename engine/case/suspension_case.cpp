@@ -248,7 +248,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
         " (10 batch means of at least 2 samples each)");
   root.finish();
 
-  // ---- lattice-unit quantities (SPEC section 2) -----------------------------
+  // ---- lattice-unit quantities (docs/model.md section 2) -----------------------------
   const int L = static_cast<int>(std::lround(c.length_over_a * a));
   const int W = static_cast<int>(std::lround(L / c.length_over_width));
   c.box = {L, W, W};

@@ -1,5 +1,5 @@
 #pragma once
-// Cases with spheres (SPEC sections 2-3): the dimensionless inputs of the
+// Cases with spheres (docs/model.md sections 2-3): the dimensionless inputs of the
 // paper's Table 1, numerics and run protocol, converted to lattice units.
 //
 //   {"scene": "suspension", "fidelity": "standard",

@@ -1,5 +1,5 @@
 #pragma once
-// Event-driven direct interactions inside one time step (SPEC.md section 3):
+// Event-driven direct interactions inside one time step (docs/model.md section 3):
 // after the time-step velocity update the spheres fly ballistically to the
 // end of the step, and every hard-sphere collision, square-well entry and
 // well-edge arrival on the way is executed in exact time order over all
@@ -31,7 +31,7 @@ struct DirectInteractionParams {
   double restitution = 1.0;      // e, in [0, 1]
   double friction = 0.0;         // mu_f >= 0
   double escape_velocity = 0.0;  // du (lattice units); 0: no square well at all
-  double well_width = 0.15;      // delta (lattice units); SPEC default 0.025 a at a = 6
+  double well_width = 0.15;      // delta (lattice units); default 0.025 a at a = 6
   // TC model (Luding & McNamara 1998) against inelastic collapse: a collision
   // of a sphere that already collided less than this time ago (within the
   // same step) is elastic. Only matters for e < 1, where a cluster of touching

@@ -1,5 +1,5 @@
 #pragma once
-// The attractive square well of width delta around each sphere pair (SPEC.md
+// The attractive square well of width delta around each sphere pair (docs/model.md
 // section 3; Smith et al. 1997 as used by Derksen 2013). Its strength is the
 // escape velocity du: the pair depth is m_p du^2 (E_swp = m_p du^2 / 2 per
 // sphere). Both rules change only the radial relative velocity
@@ -16,7 +16,7 @@ namespace flocsim::events {
 using spheres::Vec3;
 
 // Entry at |x_j - x_i| = 2 (a + delta) while closing: the radial closing speed
-// grows from |v_r| to sqrt(v_r^2 + 4 du^2). SPEC's
+// grows from |v_r| to sqrt(v_r^2 + 4 du^2). The paper's
 // J = sqrt(v_r^2 + 4 du^2) + v_r is evaluated as 4 du^2 / (sqrt(..) - v_r),
 // which is the same number without the cancellation when |v_r| >> du.
 // Returns the impulse per unit mass J (zero when du = 0).

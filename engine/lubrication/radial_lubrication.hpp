@@ -1,5 +1,5 @@
 #pragma once
-// Radial lubrication between close spheres (Nguyen & Ladd 2002, SPEC.md
+// Radial lubrication between close spheres (Nguyen & Ladd 2002, docs/model.md
 // section 3): the part of the squeeze-film force the lattice cannot resolve,
 //   F_lub = (3/2) pi rho nu a^2 (1/s - 1/s0) (n . du_ij)   for s1 < s <= s0,
 // saturated at s = s1 below s1 and zero above s0, with s = |x_j - x_i| - 2a,

@@ -1,5 +1,5 @@
 #pragma once
-// Averages of the lattice liquid that the settling observables need (SPEC
+// Averages of the lattice liquid that the settling observables need (docs/model.md
 // section 4): the mean liquid velocity <u> over the liquid volume, i.e. over
 // the cells whose centre lies outside every sphere of hydrodynamic radius a
 // (the liquid the immersed boundary keeps inside a sphere moves with the

@@ -1,6 +1,6 @@
 #pragma once
 // Published correlations the settling observables are compared with
-// (VALIDATION.md, "Random and settling suspensions"). Written out once here so
+// (docs/model.md section 5). Written out once here so
 // that result.json, the postprocess tool and the tests use the same formulas.
 namespace flocsim::observables {
 

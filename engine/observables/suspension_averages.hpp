@@ -1,5 +1,5 @@
 #pragma once
-// The settling observables of SPEC section 4 that are plain formulas of
+// The settling observables of docs/model.md section 4 that are plain formulas of
 // averages, the slab solids fraction phi(x), and the steady-state statistics
 // (batch means) with which their time series are summarised.
 #include <vector>

@@ -65,7 +65,7 @@ SceneModules modules_of(const std::string& scene) {
 
 // ---- time series -------------------------------------------------------------
 // Columns sampled every protocol.sample_every a/U_inf; scenes with a liquid add
-// the settling observables of SPEC section 4.
+// the settling observables of docs/model.md section 4.
 std::vector<std::string> columns_of(const SceneModules& m) {
   std::vector<std::string> cols = {"step",
                                    "time",
@@ -292,7 +292,7 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
   }
   for (std::size_t col = 0; col < s.series.names.size(); ++col) {
     std::string name = "/series/" + s.series.names[col];
-    // checkpoints written before C_sph had its SPEC name
+    // checkpoints written before C_sph had its present name
     if (s.series.names[col] == "C_sph" && !f.exists(name)) name = "/series/contacts_per_sphere";
     s.series.data[col] = f.read<double>(name);
   }

@@ -1,6 +1,6 @@
 #pragma once
 // The time loop of the scenes with spheres. It composes only the modules a
-// scene needs (DESIGN.md "Engine shape"), in this order within a time step:
+// scene needs (docs/architecture.md), in this order within a time step:
 //
 //   scene          liquid + IB   sphere motion      lubrication   direct interactions
 //   suspension     yes           IB + gravity       yes           yes (events)
@@ -15,7 +15,7 @@
 //   events a ballistic move).
 //
 // The liquid is driven by the body force f that balances the net gravity of
-// the spheres (SPEC section 1), so the total momentum stays zero.
+// the spheres (docs/model.md section 1), so the total momentum stays zero.
 //
 // It runs the start-up protocol of the paper (end of section 3): stage 1
 // with du = 0 until a dynamically stationary state (two-window detector on

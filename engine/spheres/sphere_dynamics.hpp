@@ -20,14 +20,14 @@
 //   lattice momentum + sum (m_p u_p - P_in(previous step))
 //
 // whose rate of change is f V_box + N (F_g - f V_p) = 0 when f and F_g balance
-// (SPEC section 1). V_p uses the hydrodynamic radius a, as phi and F_g do.
+// (docs/model.md section 1). V_p uses the hydrodynamic radius a, as phi and F_g do.
 #include <vector>
 
 #include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::spheres {
 
-// External forces of a settling suspension (SPEC section 1), lattice units,
+// External forces of a settling suspension (docs/model.md section 1), lattice units,
 // gravity along -x.
 struct SettlingForces {
   Vec3 liquid_body_force = Vec3::Zero();  // f = (rho_bar - rho) g e_x, on every lattice cell

@@ -1,6 +1,6 @@
-// Suspension cases: SPEC section 2 conversions checked by hand and against
+// Suspension cases: docs/model.md section 2 conversions checked by hand and against
 // the paper's sphere counts; the body force on the liquid balances the net
-// gravity on the spheres (SPEC section 1); bad input refused with field,
+// gravity on the spheres (docs/model.md section 1); bad input refused with field,
 // value and allowed range.
 #include "engine/case/suspension_case.hpp"
 
@@ -73,7 +73,7 @@ TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
   const SuspensionCase p =
       parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
   EXPECT_NEAR(p.liquid_body_force, (1320 / (27648 / (4 * M_PI / 3))) * 3 * p.gravity, 1e-18);
-  // SPEC section 1: f V (1 - phi) = N (rho_p - rho_bar) (4/3) pi a^3 g.
+  // docs/model.md section 1: f V (1 - phi) = N (rho_p - rho_bar) (4/3) pi a^3 g.
   const SuspensionCase c =
       parse_suspension_case({{"scene", "suspension"}, {"phi", 0.25}, {"Re_inf", 24}});
   const double volume = static_cast<double>(c.box.cells());

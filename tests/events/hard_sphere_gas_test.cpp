@@ -1,5 +1,5 @@
 // An elastic hard-sphere gas without fluid (e = 1, mu_f = 0, no wells):
-// VALIDATION.md asks for kinetic energy and momentum conserved to round-off
+// docs/model.md section 5 asks for kinetic energy and momentum conserved to round-off
 // over millions of events, no overlaps, and the collision rate of kinetic
 // theory for a dense gas.
 //

@@ -1,6 +1,6 @@
 // A gas of spheres with square wells and elastic hard cores, no fluid.
 //
-// 1. Energy bookkeeping (VALIDATION.md): kinetic energy minus the pair depth
+// 1. Energy bookkeeping (docs/model.md section 5): kinetic energy minus the pair depth
 //    m du^2 per attached pair is conserved to round-off.
 // 2. Escape statistics against the Boltzmann factor of the pair depth. In
 //    equilibrium the relative velocity of any pair is Maxwellian with the

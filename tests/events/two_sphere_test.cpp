@@ -1,4 +1,4 @@
-// Two- and three-sphere events against closed-form answers (VALIDATION.md,
+// Two- and three-sphere events against closed-form answers (docs/model.md section 5,
 // "Event-driven direct interactions"): head-on and oblique collisions of the
 // Yamamoto et al. (2001) model for several e and mu_f, capture into the
 // square well, escape at exactly 2 du and bounce just below, plus the
@@ -151,7 +151,7 @@ TEST(HardSphereCollision, RandomImpactsObeyTheDefiningLaws) {
   }
 }
 
-// Capture (SPEC: J = sqrt(v_r^2 + 4 du^2) + v_r, J n/2 on i, -J n/2 on j):
+// Capture (paper eq. 1: J = sqrt(v_r^2 + 4 du^2) + v_r, J n/2 on i, -J n/2 on j):
 // after entry the radial closing speed is sqrt(v_n^2 + 4 du^2), the
 // tangential relative velocity and the total momentum are unchanged, and the
 // pair is attached. Checked from v_n << du to v_n >> du (where the naive

@@ -1,5 +1,5 @@
 // Immersed-boundary spheres against independent references: conservation of
-// the momentum of liquid + spheres (SPEC section 1), Sangani & Acrivos drag of
+// the momentum of liquid + spheres (docs/model.md section 1), Sangani & Acrivos drag of
 // simple cubic arrays with the calibrated radius, the terminal velocity of a
 // sphere settling in creeping flow with the periodic hindrance, and the Stokes
 // torque on a rotating sphere.
@@ -28,7 +28,7 @@ double force_field_sum(const lattice::FluidLattice<Real>& fluid) {
 
 // Settling spheres with the balancing body force: the lattice momentum (the
 // raw sum of c_i f_i, i.e. without the half-force shift of the force just
-// applied) plus sum (m_p u_p - P_in) cannot change (SPEC section 1; P_in the
+// applied) plus sum (m_p u_p - P_in) cannot change (docs/model.md section 1; P_in the
 // momentum of the liquid inside the spheres, which the lattice already holds,
 // sphere_dynamics.hpp). Three spheres, density ratio 4, 600 steps.
 template <class Real>

@@ -63,7 +63,7 @@ namespace {
 using spheres::Vec3;
 
 // One sphere (rho_p/rho = 4) about to settle from rest along x in a periodic
-// box L x W x W, gravity set so that Schiller-Naumann gives U_inf (SPEC
+// box L x W x W, gravity set so that Schiller-Naumann gives U_inf (docs/model.md
 // section 2), and the Schiller-Naumann velocity U_SN for the sphere's actual
 // net weight (rho_p - rho_bar) V g.
 struct SettlingSphere {

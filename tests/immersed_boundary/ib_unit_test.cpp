@@ -141,7 +141,7 @@ TEST(SphereMarkers, SpacingNearTheRequestedValue) {
 }
 
 TEST(SanganiAcrivos, PublishedValues) {
-  // VALIDATION.md: K at phi = 0.001, 0.01, 0.05, 0.1, 0.2 (4 significant figures).
+  // docs/model.md section 5: K at phi = 0.001, 0.01, 0.05, 0.1, 0.2 (4 significant figures).
   const double phi[] = {0.001, 0.01, 0.05, 0.1, 0.2};
   const double K[] = {1.2121, 1.5857, 2.5071, 3.6425, 6.7765};
   for (int i = 0; i < 5; ++i) {
@@ -187,7 +187,7 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
 // those the hydrodynamic radius is recomputed here by inverting the
 // Sangani-Acrivos series, K(2a/L) = f L^3 / (6 pi nu a U), and must be the
 // wanted a to 0.02 dx in every box (0.5 % of a at a = 4), with the
-// runs made at the entry's a_g, and the offset a - a_g within SPEC's "typically
+// runs made at the entry's a_g, and the offset a - a_g within the model's "typically
 // <= 0.5 dx" and positive (the kernel smears the surface outwards). It also
 // checks that a = 4, 6, 8 and 12 are all there, at nu = 1/6 at least.
 TEST(CalibrationTable, ShippedEntriesReproduceTheirRadiusFromTheirOwnRuns) {
@@ -287,7 +287,7 @@ TEST(WakeSponge, ConservesMomentumMixesTheSlabAndRemovesItsOldForce) {
 }
 
 TEST(SettlingForces, BalanceOfSpecSectionOne) {
-  // f V (1 - phi) = N (rho_p - rho_bar) V_p g, with the SPEC's definitions.
+  // f V (1 - phi) = N (rho_p - rho_bar) V_p g, with the definitions of docs/model.md section 1.
   const std::size_t n = 37;
   const double a = 6, V = 100.0 * 80 * 80, g = 3e-5, ratio = 4;
   const auto f = spheres::settling_forces(n, a, ratio, V, g);

@@ -1,4 +1,4 @@
-// The lattice-Boltzmann fluid against the references of VALIDATION.md:
+// The lattice-Boltzmann fluid against the references of docs/model.md section 5:
 // analytic decay of shear waves and Taylor-Green vortices, exact momentum
 // growth under a body force, mass conservation, Galilean invariance, stability
 // at the smallest viscosity the model is used at, and float against double.
@@ -116,7 +116,7 @@ struct ShearWaveCase {
 class ShearWaveViscosity : public ::testing::TestWithParam<ShearWaveCase> {};
 
 TEST_P(ShearWaveViscosity, WithinOnePercentOfInput) {
-  // VALIDATION.md: measured nu within 1 % of the input for nu in [0.005, 0.1]
+  // docs/model.md section 5: measured nu within 1 % of the input for nu in [0.005, 0.1]
   // at moderate resolution (here 32 cells per wavelength). The run covers a
   // decay of the amplitude by a factor >= e^0.4 so the rate is well resolved.
   const auto p = GetParam();

@@ -521,7 +521,7 @@ class AnisotropicTaylorGreen : public ::testing::TestWithParam<TaylorGreenCase> 
 
 TEST_P(AnisotropicTaylorGreen, DecaysAtNuTimesK1SquaredPlusK2Squared) {
   // 48 cells per wavelength along a, 32 along b. The 1 % tolerance is the
-  // resolution tolerance of VALIDATION.md for shear-wave decay at 32 cells per
+  // resolution tolerance of docs/model.md section 5 for shear-wave decay at 32 cells per
   // wavelength; U = 0.02 keeps compressibility errors at O(U^2 / cs^2) ~ 1e-3.
   const auto p = GetParam();
   const int la = 48, lb = 32;

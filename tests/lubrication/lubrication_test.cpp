@@ -1,4 +1,4 @@
-// Radial lubrication (Nguyen & Ladd 2002) against SPEC.md section 3 and the
+// Radial lubrication (Nguyen & Ladd 2002) against docs/model.md section 3 and the
 // closed-form motion of two spheres under it.
 //
 // Closed form: for a head-on pair with radial relative velocity w = ds/dt,
@@ -41,7 +41,7 @@ SphereSet pair_at_gap(double gap, const Vec3& n, const Vec3& u0, const Vec3& u1)
   return s;
 }
 
-// SPEC: F = (3/2) pi rho nu a^2 (1/s - 1/s0)(n . du_ij) for s1 < s <= s0,
+// docs/model.md section 3: F = (3/2) pi rho nu a^2 (1/s - 1/s0)(n . du_ij) for s1 < s <= s0,
 // saturated below s1, zero above s0; +F n on i, -F n on j. Sampled over the
 // whole range, for an oblique pair; with a small dt the implicit update equals
 // the explicit impulse F dt / m to relative order 2 c dt / m (< 1e-6 here).

@@ -86,7 +86,7 @@ TEST(FluidRun, ResultHoldsExactMomentumAndAnalyticDecay) {
   EXPECT_EQ(on_disk, r.result);
   EXPECT_EQ(on_disk["status"], "completed");
   const auto& obs = on_disk["observables"];
-  // momentum grows by exactly f per cell per step (VALIDATION.md)
+  // momentum grows by exactly f per cell per step (docs/model.md section 5)
   for (int d = 0; d < 3; ++d)
     EXPECT_NEAR(obs["momentum_final"][d].get<double>(), obs["momentum_expected"][d].get<double>(),
                 1e-11);

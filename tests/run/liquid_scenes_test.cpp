@@ -6,7 +6,7 @@
 //     states and observables;
 //   - one sphere settling in a periodic cube in creeping flow, and the same
 //     sphere held fixed with the liquid driven past it, give the drag of the
-//     simple cubic array of Sangani & Acrivos (1982), VALIDATION.md;
+//     simple cubic array of Sangani & Acrivos (1982), docs/model.md section 5;
 //   - the momentum of liquid + spheres does not drift.
 #include <gtest/gtest.h>
 
@@ -166,7 +166,7 @@ TEST(LiquidScenes, SuspensionStopAndResumeIsBitIdentical) {
   fs::remove_all(split);
 }
 
-// The corners of the paper's grid (SPEC: phi 0.12-0.32, Re_inf 6-72, du/U_inf
+// The corners of the paper's grid (paper Table 1: phi 0.12-0.32, Re_inf 6-72, du/U_inf
 // up to 0.03), densest and most inertial with the strongest well, and dilute
 // and slow: the default numerics (nu = 0.005, tau = 0.515 at Re_inf = 72) stay
 // stable, spheres never overlap beyond the event engine's tolerance, and the
@@ -215,7 +215,7 @@ TEST(LiquidScenes, CornersOfTheParameterSpaceStayStable) {
 // liquid's stresses, f V for a pressure gradient f, equals 6 pi mu a U K(chi)
 // with U the superficial velocity. flocsim's F = F_h / (6 pi mu a U) counts
 // F_h = f V_p (1/phi - 1) = f (V - V_p), the drag without the mean pressure
-// gradient's buoyancy (VALIDATION.md: state the normalisation), so
+// gradient's buoyancy (docs/model.md section 5: state the normalisation), so
 // F = (1 - phi) K(chi).
 json creeping_cube(const std::string& scene) {
   json j = json::parse(R"({

@@ -61,7 +61,7 @@ TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
 
 TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
   // e = 1, no friction, no liquid: kinetic energy minus m_p du^2 per attached
-  // pair is conserved to round-off (VALIDATION.md) over the statistics window,
+  // pair is conserved to round-off (docs/model.md section 5) over the statistics window,
   // with many collisions, captures and escapes, and no overlap.
   const cases::SuspensionCase c = granular(0.5);
   const fs::path dir = fresh_dir("energy");
