@@ -213,5 +213,25 @@ TEST(SuspensionCase, FixedArrayFromASnapshot) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(SuspensionCaseRefusals, EmptyPositionsFromNamesThePath) {
+  // "phi is missing" was the answer; the empty path is the mistake.
+  EXPECT_THAT(refusal({{"scene", "fixed-array"}, {"positions_from", ""}}),
+              AllOf(HasSubstr("positions_from = \"\""), HasSubstr("snapshot")));
+}
+
+TEST(SuspensionCaseRefusals, ViscosityBelowTheStableRangeIsRefusedUpFront) {
+  // 1e-10 implied 5e10 steps per a/U_inf and failed mid-run; 0.005 (tau =
+  // 0.515) is the smallest viscosity the coupled solver is tested stable at.
+  for (double nu : {0.001, 1e-4, 1e-10})
+    EXPECT_THAT(refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"viscosity", nu}}}}),
+                AllOf(HasSubstr("numerics.viscosity"), HasSubstr(">= 0.005")));
+  // through U_inf: Re_inf = 72, a = 6, U_inf = 0.01 gives nu = 0.01 * 12 / 72
+  // = 0.00167; U_inf = 72 * 0.005 / 12 = 0.03 would reach 0.005.
+  EXPECT_THAT(
+      refusal(
+          {{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}, {"numerics", {{"U_inf", 0.01}}}}),
+      AllOf(HasSubstr("numerics.U_inf"), HasSubstr("0.001666"), HasSubstr("at least 0.03")));
+}
+
 }  // namespace
 }  // namespace flocsim::cases
