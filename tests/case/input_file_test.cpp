@@ -18,7 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-using ::testing::Not;
 
 fs::path write_file(const std::string& name, const std::string& text) {
   const fs::path p =
