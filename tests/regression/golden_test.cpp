@@ -31,6 +31,23 @@ using json = nlohmann::json;
 
 const fs::path kGolden = fs::path(FLOCSIM_SOURCE_DIR) / "tests" / "regression" / "golden";
 
+// Bit-for-bit holds for one instruction set: the build uses -march=native, and
+// another vector width or FMA contraction changes the last bits, which the
+// suspension's collisions then amplify. The golden files record the machine's
+// set; on another one the comparison is skipped with the way to make new ones.
+std::string instruction_set() {
+  std::string s = "x86-64";
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2")) s += " avx2";
+  if (__builtin_cpu_supports("fma")) s += " fma";
+  if (__builtin_cpu_supports("avx512f")) s += " avx512f";
+#else
+  s = "other";
+#endif
+  return s;
+}
+
 bool writing_golden() {
   const char* w = std::getenv("FLOCSIM_WRITE_GOLDEN");
   return w && std::string(w) == "1";
@@ -83,6 +100,15 @@ json read_json(const fs::path& p) {
 // Runs one golden case and compares (or, with FLOCSIM_WRITE_GOLDEN=1, writes).
 void check_scene(const std::string& scene) {
   const fs::path golden = kGolden / scene;
+  if (!writing_golden()) {
+    std::string recorded;
+    std::getline(std::ifstream(kGolden / "instruction_set.txt"), recorded);
+    if (recorded != instruction_set())
+      GTEST_SKIP() << "the golden files were written on a machine with instruction set '"
+                   << recorded << "', this one has '" << instruction_set()
+                   << "': write them here from the commit before the change with "
+                      "FLOCSIM_WRITE_GOLDEN=1 and compare the change against them";
+  }
   const json document = input::read_json_file((golden / "case.json").string());
   const fs::path out = flocsim::testing::fresh_dir("golden_" + scene);
   RunOptions o;
@@ -94,6 +120,7 @@ void check_scene(const std::string& scene) {
   const json observables = read_json(out / "result.json")["observables"];
   const bool series = fs::exists(out / "series.h5");
   if (writing_golden()) {
+    std::ofstream(kGolden / "instruction_set.txt") << instruction_set() << "\n";
     std::ofstream(golden / "observables.json") << observables.dump(2) << "\n";
     if (series)
       fs::copy_file(out / "series.h5", golden / "series.h5", fs::copy_options::overwrite_existing);
