@@ -16,6 +16,7 @@
 
 #include "engine/events/direct_interactions.hpp"
 #include "engine/lubrication/radial_lubrication.hpp"
+#include "engine/lubrication/two_sphere_resistance.hpp"
 
 namespace flocsim::lubrication {
 namespace {
@@ -162,6 +163,37 @@ TEST(RadialLubrication, SaturatedApproachSlowsWithoutOverlap) {
 TEST(RadialLubrication, RefusesBadParameters) {
   EXPECT_THROW(RadialLubrication({.viscosity = 0}), std::invalid_argument);
   EXPECT_THROW(RadialLubrication({.onset_gap = 0.1, .saturation_gap = 0.2}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace flocsim::lubrication
+
+namespace flocsim::lubrication {
+namespace {
+
+TEST(BrennerPairResistance, FarFieldNearFieldAndAMeasuredValue) {
+  // Far apart, reflections: each sphere moves against the Stokeslet of the
+  // other, lambda = 1 + (3/4)(a/h) + (9/16)(a/h)^2 + O((a/h)^3), h = a + s/2
+  // the distance to the midplane. At h = 50a: 1.015225 (by hand).
+  EXPECT_NEAR(brenner_pair_resistance(98.0), 1.0 + 0.75 / 50 + 0.5625 / 2500, 1e-5);
+  // Close, lubrication theory (Cox & Brenner 1967): lambda = a/(2s) + (9/20)
+  // ln(a/s) + C + O(s ln s): the remainder settles to a constant.
+  auto remainder = [](double e) {
+    return brenner_pair_resistance(e) - 0.5 / e - 0.45 * std::log(1 / e);
+  };
+  EXPECT_NEAR(remainder(1e-3), remainder(1e-4), 5e-3);
+  // the squeeze film dominates: at s = 1e-4 a the log and constant terms add
+  // 2e-4 (0.45 ln 1e4 + ~1.35) = 0.0011 to the leading term's 1
+  EXPECT_NEAR(brenner_pair_resistance(1e-4) * 2e-4, 1.0011, 1e-4);
+  // the value quoted for the IB measurement at s = 0.05a: 12.7
+  EXPECT_NEAR(brenner_pair_resistance(0.05), 12.7, 0.05);
+  // monotone: closer is stiffer
+  double last = 1.0;
+  for (double e : {10.0, 1.0, 0.3, 0.1, 0.03, 0.01}) {
+    const double l = brenner_pair_resistance(e);
+    EXPECT_GT(l, last) << e;
+    last = l;
+  }
 }
 
 }  // namespace
