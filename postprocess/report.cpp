@@ -83,7 +83,8 @@ void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>flocsim results: "
     << escape(database) << "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:"
-    << "1400px}table{border-collapse:collapse;font-size:13px;margin-bottom:1.5em}td,th{white-space:nowrap;border:1px "
+    << "1400px}table{border-collapse:collapse;font-size:13px;margin-bottom:1.5em}td,th{white-space:"
+       "nowrap;border:1px "
        "solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}img{max-width:100%;"
        "border:1px solid #ddd}figure{margin:1.5em 0}figcaption{font-size:13px;color:#333}"
        ".bad{color:#a00}</style></head><body>\n";
