@@ -90,7 +90,7 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
             u.window_end = obs["window"].value("end", 0.0);
           }
           u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
-          if (u.phi == 0) u.phi = res["derived"].value("phi_realised", 0.0);
+          if (u.phi == 0) u.phi = res.value("derived", json::object()).value("phi_realised", 0.0);
         }
       }
       // the same filters as `flocsim query`: a case path, the status or an observable
@@ -121,7 +121,9 @@ Measured ratio(const Measured& a, const Measured& b) {
 std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs) {
   std::map<std::string, std::vector<const RunSummary*>> zero_du;  // by case identity
   for (const RunSummary& r : runs)
-    if (r.du == 0) zero_du[orchestrator::canonical_text(r.case_json)].push_back(&r);
+    // keyed like the lookup below, so that a case that leaves du_over_Uinf
+    // at its default 0 is found too
+    if (r.du == 0) zero_du[baseline_key(r.case_json)].push_back(&r);
   std::vector<AggregationRow> rows;
   for (const RunSummary& r : runs) {
     if (r.du <= 0) continue;

@@ -65,7 +65,7 @@ class Post : public ::testing::Test {
     std::vector<db::ResultsDb::NewRun> news;
     for (const HandRun& r : runs)
       news.push_back({r.id, orchestrator::canonical_text(r.case_json), (dir_ / r.id).string(),
-                      json{{"du_over_Uinf", r.case_json["du_over_Uinf"]}}.dump()});
+                      json{{"du_over_Uinf", r.case_json.value("du_over_Uinf", 0.0)}}.dump()});
     db.add_runs(sweep, news);
     db::AttemptStart start;
     start.host = "test";
@@ -95,7 +95,7 @@ class Post : public ::testing::Test {
       rec.observables = {{"F", r.F, r.F_err}, {"n_a_mean", r.n_a, r.n_a_err}, {"Re", 4.0, 0.1},
                          {"Re_T", 1.0, 0.05}, {"U_over_Uinf", 0.3, 0.01},     {"C_sph", 1.0, 0.1}};
       db.record_result(claim->attempt_id, rec);
-      if (with_series) write_series(dir_ / r.id, r.case_json["du_over_Uinf"].get<double>());
+      if (with_series) write_series(dir_ / r.id, r.case_json.value("du_over_Uinf", 0.0));
     }
     return path;
   }
@@ -157,6 +157,19 @@ TEST_F(Post, AggregationTableEqualsAHandCalculation) {
   EXPECT_THAT(csv.str(), HasSubstr(",0.75,0.03181980515,"));  // full precision in CSV
   EXPECT_THAT(tex.str(), HasSubstr("$0.75 \\pm 0.03$"));
   EXPECT_THAT(tex.str(), HasSubstr("\\toprule"));
+}
+
+TEST_F(Post, ABaselineThatLeavesDuAtItsDefaultIsFound) {
+  // du_over_Uinf absent from the baseline's case means 0, its default
+  json base = suspension(0);
+  base.erase("du_over_Uinf");
+  const std::string db_path =
+      write_db({{"base", base, "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4}});
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto rows = aggregation_table(load_runs(db, std::nullopt, {}));
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_NE(rows[0].baseline, nullptr) << rows[0].reason;
 }
 
 TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {
