@@ -217,8 +217,11 @@ TEST_F(Post, SeveralSweepsInOneDatabase) {
   EXPECT_EQ(all.size(), 3u);
   const auto rows = aggregation_table(all);
   ASSERT_EQ(rows.size(), 2u);
-  for (const auto& r : rows)
-    if (r.run->id == "new") EXPECT_THAT(r.reason, HasSubstr("this run is pending"));
+  for (const auto& r : rows) {
+    if (r.run->id == "new") {
+      EXPECT_THAT(r.reason, HasSubstr("this run is pending"));
+    }
+  }
   const auto other = load_runs(db, std::string("other"), {});
   EXPECT_EQ(other.size(), 2u);
 }
