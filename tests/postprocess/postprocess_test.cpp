@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -192,6 +193,28 @@ TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {
   EXPECT_THAT(reason["a6"], HasSubstr("no du = 0 run of the same case"));
   EXPECT_THAT(reason["a24"], HasSubstr("baseline f24 is failed"));
   EXPECT_THAT(reason["run"], HasSubstr("this run is running"));
+  // a run with no result has no verdict on its errors or stationarity: blank, not "yes"
+  std::ostringstream csv;
+  write_aggregation(rows, "csv", csv);
+  std::istringstream lines(csv.str());
+  std::string header, line;
+  std::getline(lines, header);
+  std::vector<std::string> names;
+  for (std::istringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+  const auto column = [&](const std::string& name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  bool seen_running = false;
+  while (std::getline(lines, line)) {
+    std::vector<std::string> cells;
+    for (std::istringstream c(line); std::getline(c, header, ',');) cells.push_back(header);
+    cells.resize(names.size());
+    if (cells[column("run")] != "run") continue;
+    seen_running = true;
+    EXPECT_EQ(cells[column("errors_reliable")], "");
+    EXPECT_EQ(cells[column("stationary")], "");
+  }
+  EXPECT_TRUE(seen_running);
   // a filter as in flocsim query
   const auto only24 = load_runs(db, std::nullopt, {orchestrator::parse_filter("Re_inf=24")});
   EXPECT_EQ(only24.size(), 3u);
