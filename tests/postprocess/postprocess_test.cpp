@@ -304,6 +304,21 @@ TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
         "pair_structure_phi0.2_Re12", "spacetime_phi0.2_Re12_du0.02", "n_a_vs_du",
         "drag_vs_Re_per_du", "drag_ratio_vs_size_ratio"})
     EXPECT_TRUE(names.count(want)) << want;
+  // A two-panel figure draws both panels into the PDF too: every plot command appears once
+  // per terminal (gnuplot 5.4's replot after a multiplot would redraw only the last panel).
+  for (const char* two_panels : {"timeseries_phi0.2_Re12", "pair_structure_phi0.2_Re12"}) {
+    std::ifstream gp(dir_ / "figures" / "scripts" / (std::string(two_panels) + ".gp"));
+    std::string line;
+    int plots_png = 0, plots_pdf = 0;
+    bool pdf = false;
+    while (std::getline(gp, line)) {
+      if (line.rfind("set terminal pdfcairo", 0) == 0) pdf = true;
+      if (line.rfind("plot ", 0) == 0) ++(pdf ? plots_pdf : plots_png);
+      EXPECT_NE(line, "replot") << two_panels;
+    }
+    EXPECT_EQ(plots_png, 2) << two_panels;
+    EXPECT_EQ(plots_pdf, 2) << two_panels;
+  }
   write_report(runs, set, db_path, dir_ / "report.html");
   std::ifstream in(dir_ / "report.html");
   std::stringstream html;
