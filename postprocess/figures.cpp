@@ -302,13 +302,14 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       }
       // a colour scale symmetric about zero: white is the mean solids fraction
       const std::string file = p.data("", rows.str());
-      p.commands() << "set xlabel 't U_{inf} / a'\nset ylabel 'x / L'\nset cblabel "
-                      "'phi(x,t) - phi'\nset palette defined (-1 'blue', 0 'white', 1 'red')\n"
-                      "stats "
-                   << file
-                   << " using 3 nooutput\nm = abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : "
-                      "abs(STATS_max)\nset cbrange [-m:m]\nplot "
-                   << file << " using 1:2:3 with image notitle\n";
+      p.commands()
+          << "set xlabel 't U_{inf} / a'\nset ylabel 'x / L'\nset cblabel "
+             "'phi(x,t) - phi'\nset palette defined (-1 'blue', 0 'white', 1 'red')\n"
+             "stats "
+          << file
+          << " using 3 nooutput\nm = abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : "
+             "abs(STATS_max)\nset cbrange [-m:m]\nset autoscale xfix\nset autoscale yfix\nplot "
+          << file << " using 1:2:3 with image notitle\n";
       set.figures.push_back(p.render());
     }
   }
