@@ -47,16 +47,19 @@ class Plot {
     fs::create_directories(dir_ / "scripts");
     Figure f{name_, caption_, dir_ / (name_ + ".png"), dir_ / (name_ + ".pdf")};
     const fs::path script = dir_ / "scripts" / (name_ + ".gp");
+    // keep symbols off the frame (not for maps, which fill it)
+    const std::string offsets =
+        name_.rfind("spacetime", 0) == 0
+            ? ""
+            : "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
+    // The commands once per terminal, from a reset state, not replot: gnuplot 5.4's replot
+    // after a multiplot redraws only its last panel.
     std::ofstream(script) << "set terminal pngcairo size " << size_png
-                          << " enhanced font 'sans,11'\nset output '" << f.png.string()
-                          << "'\n"
-                          // keep symbols off the frame (not for maps, which fill it)
-                          << (name_.rfind("spacetime", 0) == 0
-                                  ? ""
-                                  : "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n")
-                          << commands_.str() << "\nset terminal pdfcairo size " << size_pdf
-                          << " enhanced font 'sans,9'\nset output '" << f.pdf.string()
-                          << "'\nreplot\nunset output\n";
+                          << " enhanced font 'sans,11'\nset output '" << f.png.string() << "'\n"
+                          << offsets << commands_.str() << "\nunset output\nreset\n"
+                          << "set terminal pdfcairo size " << size_pdf
+                          << " enhanced font 'sans,9'\nset output '" << f.pdf.string() << "'\n"
+                          << offsets << commands_.str() << "\nunset output\n";
     const std::string cmd = "gnuplot '" + script.string() + "' > '" +
                             (dir_ / "scripts" / (name_ + ".log")).string() + "' 2>&1";
     if (std::system(cmd.c_str()) != 0)
@@ -272,10 +275,14 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                   " with lines lw 2 title 'du/U_{inf} = " + num(r->du) + "'";
       }
       if (!top.empty()) {
-        p.commands() << "set multiplot layout 2,1\nset grid\nset xlabel 'r/a'\nset ylabel "
-                        "'g(r)'\nplot "
-                     << top << "\nset xlabel 'theta (rad)'\nset ylabel 'h(theta)'\nplot " << bottom
-                     << "\nunset multiplot\n";
+        // g and h are non-negative, r and theta start at 0: no padding below 0
+        p.commands()
+            << "set multiplot layout 2,1\nset grid\nset xlabel 'r/a'\nset ylabel "
+               "'g(r)'\nset offsets 0, 0, graph 0.05, 0\nset xrange [0:*]\nset yrange [0:*]\nplot "
+            << top
+            << "\nset xlabel 'theta (rad)'\nset ylabel 'h(theta)'\nset xrange [0:pi]\n"
+               "plot "
+            << bottom << "\nunset multiplot\n";
         set.figures.push_back(p.render("900,800", "6in,5.4in"));
       }
     }
@@ -295,13 +302,14 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       }
       // a colour scale symmetric about zero: white is the mean solids fraction
       const std::string file = p.data("", rows.str());
-      p.commands() << "set xlabel 't U_{inf} / a'\nset ylabel 'x / L'\nset cblabel "
-                      "'phi(x,t) - phi'\nset palette defined (-1 'blue', 0 'white', 1 'red')\n"
-                      "stats "
-                   << file
-                   << " using 3 nooutput\nm = abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : "
-                      "abs(STATS_max)\nset cbrange [-m:m]\nplot "
-                   << file << " using 1:2:3 with image notitle\n";
+      p.commands()
+          << "set xlabel 't U_{inf} / a'\nset ylabel 'x / L'\nset cblabel "
+             "'phi(x,t) - phi'\nset palette defined (-1 'blue', 0 'white', 1 'red')\n"
+             "stats "
+          << file
+          << " using 3 nooutput\nm = abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : "
+             "abs(STATS_max)\nset cbrange [-m:m]\nset autoscale xfix\nset autoscale yfix\nplot "
+          << file << " using 1:2:3 with image notitle\n";
       set.figures.push_back(p.render());
     }
   }

@@ -65,8 +65,13 @@ std::string html_table(const std::string& markdown) {
       start = end + 2;
     }
     out += "<tr>";
-    for (const auto& c : cells)
-      out += (head ? "<th>" : "<td>") + escape(c) + (head ? "</th>" : "</td>");
+    for (const auto& c : cells) {
+      // Numbers keep "mean ± error" on one line; a long verdict or reason (the drifting
+      // observables, why a run has no baseline) wraps so the table fits the page.
+      const bool prose = !head && c.size() > 24 && c.find("±") == std::string::npos;
+      out += (head ? "<th>" : (prose ? "<td class='prose'>" : "<td>")) + escape(c) +
+             (head ? "</th>" : "</td>");
+    }
     out += "</tr>\n";
     head = false;
   }
@@ -87,7 +92,8 @@ void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
        "nowrap;border:1px "
        "solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}img{max-width:100%;"
        "border:1px solid #ddd}figure{margin:1.5em 0}figcaption{font-size:13px;color:#333}"
-       ".bad{color:#a00}</style></head><body>\n";
+       ".bad{color:#a00}td.prose{white-space:normal;min-width:14em;text-align:left}</style></"
+       "head><body>\n";
   h << "<h1>flocsim results</h1>\n<p>Database <code>" << escape(database)
     << "</code>: " << runs.size()
     << " runs. Errors are batch-means standard errors; ratios carry first-order "

@@ -247,7 +247,13 @@ std::string yes_no(bool b) {
   return b ? "yes" : "no";
 }
 
+// A run with no result yet (pending, running, failed) has neither verdict: blank, not "yes".
+std::string reliable_text(const RunSummary& r) {
+  return r.has_result ? yes_no(r.errors_reliable) : "";
+}
+
 std::string stationary_text(const RunSummary& r) {
+  if (!r.has_result) return "";
   if (r.not_stationary.empty()) return "yes";
   std::string s = "no:";
   for (const auto& n : r.not_stationary) s += " " + n;
@@ -306,7 +312,7 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
     w.measured(r.Re_T);
     w.text(window_text(r));
     w.text(r.sphere_count ? std::to_string(r.sphere_count) : "");
-    w.text(b ? yes_no(r.errors_reliable && b->errors_reliable) : yes_no(r.errors_reliable));
+    w.text(b && r.has_result ? yes_no(r.errors_reliable && b->errors_reliable) : reliable_text(r));
     w.text(b && !b->not_stationary.empty()
                ? stationary_text(r) + "; baseline " + stationary_text(*b)
                : stationary_text(r));
@@ -345,7 +351,7 @@ void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std
       w.text("");
     w.text(window_text(r));
     w.text(r.sphere_count ? std::to_string(r.sphere_count) : "");
-    w.text(yes_no(r.errors_reliable));
+    w.text(reliable_text(r));
     w.text(stationary_text(r));
     w.text(r.id.substr(0, 12));
     w.end_row();

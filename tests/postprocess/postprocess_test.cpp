@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -192,6 +193,28 @@ TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {
   EXPECT_THAT(reason["a6"], HasSubstr("no du = 0 run of the same case"));
   EXPECT_THAT(reason["a24"], HasSubstr("baseline f24 is failed"));
   EXPECT_THAT(reason["run"], HasSubstr("this run is running"));
+  // a run with no result has no verdict on its errors or stationarity: blank, not "yes"
+  std::ostringstream csv;
+  write_aggregation(rows, "csv", csv);
+  std::istringstream lines(csv.str());
+  std::string header, line;
+  std::getline(lines, header);
+  std::vector<std::string> names;
+  for (std::istringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+  const auto column = [&](const std::string& name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  bool seen_running = false;
+  while (std::getline(lines, line)) {
+    std::vector<std::string> cells;
+    for (std::istringstream c(line); std::getline(c, header, ',');) cells.push_back(header);
+    cells.resize(names.size());
+    if (cells[column("run")] != "run") continue;
+    seen_running = true;
+    EXPECT_EQ(cells[column("errors_reliable")], "");
+    EXPECT_EQ(cells[column("stationary")], "");
+  }
+  EXPECT_TRUE(seen_running);
   // a filter as in flocsim query
   const auto only24 = load_runs(db, std::nullopt, {orchestrator::parse_filter("Re_inf=24")});
   EXPECT_EQ(only24.size(), 3u);
@@ -217,8 +240,11 @@ TEST_F(Post, SeveralSweepsInOneDatabase) {
   EXPECT_EQ(all.size(), 3u);
   const auto rows = aggregation_table(all);
   ASSERT_EQ(rows.size(), 2u);
-  for (const auto& r : rows)
-    if (r.run->id == "new") EXPECT_THAT(r.reason, HasSubstr("this run is pending"));
+  for (const auto& r : rows) {
+    if (r.run->id == "new") {
+      EXPECT_THAT(r.reason, HasSubstr("this run is pending"));
+    }
+  }
   const auto other = load_runs(db, std::string("other"), {});
   EXPECT_EQ(other.size(), 2u);
 }
@@ -278,6 +304,21 @@ TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
         "pair_structure_phi0.2_Re12", "spacetime_phi0.2_Re12_du0.02", "n_a_vs_du",
         "drag_vs_Re_per_du", "drag_ratio_vs_size_ratio"})
     EXPECT_TRUE(names.count(want)) << want;
+  // A two-panel figure draws both panels into the PDF too: every plot command appears once
+  // per terminal (gnuplot 5.4's replot after a multiplot would redraw only the last panel).
+  for (const char* two_panels : {"timeseries_phi0.2_Re12", "pair_structure_phi0.2_Re12"}) {
+    std::ifstream gp(dir_ / "figures" / "scripts" / (std::string(two_panels) + ".gp"));
+    std::string line;
+    int plots_png = 0, plots_pdf = 0;
+    bool pdf = false;
+    while (std::getline(gp, line)) {
+      if (line.rfind("set terminal pdfcairo", 0) == 0) pdf = true;
+      if (line.rfind("plot ", 0) == 0) ++(pdf ? plots_pdf : plots_png);
+      EXPECT_NE(line, "replot") << two_panels;
+    }
+    EXPECT_EQ(plots_png, 2) << two_panels;
+    EXPECT_EQ(plots_pdf, 2) << two_panels;
+  }
   write_report(runs, set, db_path, dir_ / "report.html");
   std::ifstream in(dir_ / "report.html");
   std::stringstream html;
