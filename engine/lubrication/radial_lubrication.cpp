@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "engine/lubrication/two_sphere_resistance.hpp"
 #include "engine/neighbours/pair_search.hpp"
 
 namespace flocsim::lubrication {
@@ -27,6 +28,14 @@ void LubricationParams::check() const {
   require(onset_gap > 0 && std::isfinite(onset_gap), "onset_gap", onset_gap, "(0, inf)");
   require(saturation_gap > 0 && saturation_gap < onset_gap, "saturation_gap", saturation_gap,
           "(0, onset_gap)");
+  for (std::size_t k = 0; k < lattice_share.size(); ++k) {
+    require(lattice_share[k].first > 0 && std::isfinite(lattice_share[k].first),
+            "lattice_share gap", lattice_share[k].first, "(0, inf)");
+    require(k == 0 || lattice_share[k].first > lattice_share[k - 1].first, "lattice_share gap",
+            lattice_share[k].first, "increasing");
+    require(lattice_share[k].second > 0 && std::isfinite(lattice_share[k].second),
+            "lattice_share lambda", lattice_share[k].second, "(0, inf)");
+  }
 }
 
 RadialLubrication::RadialLubrication(LubricationParams params) : params_(params) {
@@ -38,6 +47,21 @@ double RadialLubrication::coefficient(double gap, double radius) const {
   const double s1 = params_.saturation_gap * radius;
   if (gap > s0) return 0.0;
   const double s = std::max(gap, s1);
+  if (!params_.lattice_share.empty()) {
+    const auto& t = params_.lattice_share;
+    const double e = s / radius;
+    double share = t.front().second;
+    if (e >= t.back().first) {
+      share = t.back().second;
+    } else if (e > t.front().first) {
+      std::size_t k = 1;
+      while (t[k].first < e) ++k;
+      const double f = (e - t[k - 1].first) / (t[k].first - t[k - 1].first);
+      share = t[k - 1].second + f * (t[k].second - t[k - 1].second);
+    }
+    const double excess = brenner_pair_resistance(e) - share;
+    return 6.0 * M_PI * params_.liquid_density * params_.viscosity * radius * std::max(0.0, excess);
+  }
   return 1.5 * M_PI * params_.liquid_density * params_.viscosity * radius * radius *
          (1.0 / s - 1.0 / s0);
 }

@@ -10,6 +10,9 @@
 // it overshoots once 2 c dt / m > 1 (at s1, a = 6, nu = 0.01 it is ~0.8);
 // integrated implicitly per pair, w' = w / (1 + 2 c dt / m), it only ever
 // shrinks w towards zero and can never reverse an approach.
+#include <utility>
+#include <vector>
+
 #include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::lubrication {
@@ -23,6 +26,15 @@ struct LubricationParams {
   double liquid_density = 1.0;   // rho, lattice units
   double onset_gap = 0.2;        // s0 / a
   double saturation_gap = 2e-4;  // s1 / a
+  // Optional calibration (docs/contacts.md, "Calibrated close-pair
+  // coefficient"): the lattice's own measured radial resistance lambda_IB(s/a)
+  // of a held IB pair, periodic-box offset removed, as (s/a, lambda_IB) points
+  // in increasing s/a. When given, the coefficient below s0 is the exact
+  // (Brenner) resistance minus the lattice's share,
+  //   c(s) = 6 pi rho nu a max(0, lambda_exact(s/a) - lambda_IB(s/a)),
+  // lambda_IB linear between points and held at the end values outside them,
+  // instead of the Nguyen-Ladd (3/2) pi rho nu a^2 (1/s - 1/s0). Empty: Nguyen-Ladd.
+  std::vector<std::pair<double, double>> lattice_share;
 
   void check() const;  // std::invalid_argument naming the field, value and allowed range
 };
