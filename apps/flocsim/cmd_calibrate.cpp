@@ -7,12 +7,20 @@
 // --boxes is given) in creeping flow, finds the input radius a_g whose drag
 // matches Sangani & Acrivos, and adds the entry to the table (read first when
 // it exists, so tables grow one resolution at a time).
+//
+//   flocsim calibrate --close-pairs --radius 4 6 --viscosity 0.02 --table FILE
+//
+// measures instead the lattice's own radial resistance of a held pair of
+// spheres at the gaps of --gaps (default 0.005a to 0.5a), approaching (or
+// --separating), against Brenner's exact series: the close-pair calibration
+// that the lubrication correction subtracts (docs/contacts.md).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "engine/calibration/hydrodynamic_radius.hpp"
+#include "engine/calibration/pair_resistance.hpp"
 
 namespace flocsim::app {
 namespace {
@@ -26,7 +34,47 @@ struct CalibrateOptions {
   int iterations = 2;
   double tolerance = 1e-6;
   std::string table;
+  bool close_pairs = false;
+  bool separating = false;
+  std::vector<double> gaps;
+  double pair_box_over_a = 16;
 };
+
+void print_pair_point(const calibration::PairResistancePoint& p) {
+  std::printf("  s/a = %6.3f  lambda = %9.4f  exact %9.4f  steps %7ld\n", p.gap_over_a,
+              p.lambda_measured, p.lambda_exact, p.steps);
+  std::fflush(stdout);
+}
+
+int run_pair_calibration(const CalibrateOptions& o) {
+  calibration::PairResistanceTable table;
+  if (std::filesystem::exists(o.table)) table = calibration::PairResistanceTable::load(o.table);
+  table.note =
+      "The lattice's own radial resistance lambda of two immersed-boundary spheres held at gap s "
+      "and moved towards each other at +-V (Re = 2aV/nu = 0.01), box L x L/2 x L/2 (L, the "
+      "box field of each entry, is 16a or 12a), double precision, steady to 2e-6 per 200 steps, "
+      "against Brenner's (1961) exact lambda. box_offset "
+      "(measured minus exact at the largest gap) is the periodic images' share, removed at every "
+      "gap. Made by `flocsim calibrate --close-pairs`; see docs/contacts.md.";
+  calibration::PairResistanceSettings s;
+  s.viscosity = o.viscosity;
+  s.marker_spacing = o.marker_spacing;
+  s.iterations = o.iterations;
+  s.box_over_a = o.pair_box_over_a;
+  const auto gaps = o.gaps.empty() ? calibration::default_pair_gaps() : o.gaps;
+  for (double a : o.radii) {
+    std::printf("close pair, a = %g dx, nu = %g, %s:\n", a, o.viscosity,
+                o.separating ? "separating" : "approaching");
+    const auto e =
+        calibration::calibrate_pair_resistance(a, gaps, o.separating, s, print_pair_point);
+    std::printf("=> box offset %+.4f (at s/a = %g); lambda_IB = measured - offset\n", e.box_offset,
+                gaps.back());
+    table.add(e);
+    table.save(o.table);
+  }
+  std::printf("table written to %s\n", o.table.c_str());
+  return kExitOk;
+}
 
 void print_run(const calibration::ArrayDragResult& r) {
   std::printf(
@@ -37,6 +85,7 @@ void print_run(const calibration::ArrayDragResult& r) {
 }
 
 int run_calibrate(const CalibrateOptions& o) {
+  if (o.close_pairs) return run_pair_calibration(o);
   calibration::CalibrationTable table;
   if (std::filesystem::exists(o.table)) table = calibration::CalibrationTable::load(o.table);
   table.note =
@@ -91,6 +140,18 @@ const bool registered = register_command(
        cmd.add_option("--tolerance", o->tolerance,
                       "steady state: relative change of U per 100 steps")
            ->check(CLI::Range(1e-10, 1e-3));
+       cmd.add_flag("--close-pairs", o->close_pairs,
+                    "measure the lattice's own close-pair resistance instead (lubrication "
+                    "calibration)");
+       cmd.add_flag("--separating", o->separating, "with --close-pairs: spheres moving apart");
+       cmd.add_option("--gaps", o->gaps,
+                      "with --close-pairs: gaps s/a, increasing; the last "
+                      "gives the box offset (default 0.005 ... 0.5)")
+           ->check(CLI::Range(1e-4, 2.0));
+       cmd.add_option("--pair-box", o->pair_box_over_a,
+                      "with --close-pairs: box length along the pair in units of a (cross-section "
+                      "half of it)")
+           ->check(CLI::Range(8.0, 64.0));
        cmd.add_option("--table", o->table, "calibration table (JSON), read and extended")
            ->required();
        return [o] { return run_calibrate(*o); };

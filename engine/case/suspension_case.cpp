@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "engine/calibration/hydrodynamic_radius.hpp"
+#include "engine/calibration/pair_resistance.hpp"
 #include "engine/case/case_support.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -120,6 +121,10 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
   c.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
   c.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
+  c.lubrication_model =
+      root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "nguyen-ladd");
+  c.lubrication_integration =
+      root.choice("lubrication_integration", {"implicit", "explicit-paper"}, "implicit");
   c.lubrication_onset_over_a =
       root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
   c.lubrication_saturation_over_a = root.number(
@@ -225,6 +230,20 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                            "; `flocsim calibrate --viscosity` makes one for this viscosity");
   }
 
+  if (c.scene == "suspension" && c.lubrication_model == "calibrated") {
+    const auto& pairs = calibration::PairResistanceTable::shipped();
+    try {
+      c.lubrication_lattice_share = pairs.lattice_share(a, c.viscosity);
+    } catch (const std::out_of_range& e) {
+      throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
+                       format_value(a) + ": " + e.what());
+    }
+    if (c.input_radius_given)
+      c.warnings.push_back(
+          "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +
+          format_value(a) + "; with numerics.input_radius given it holds only approximately");
+  }
+
   InputReader pr = root.object("protocol");
   const Range duration{.at_least = 0, .at_most = 1e5};
   c.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
@@ -314,6 +333,8 @@ nlohmann::json SuspensionCase::to_json() const {
   j["delta_over_a"] = delta_over_a;
   j["restitution"] = restitution;
   j["friction"] = friction;
+  j["lubrication_model"] = lubrication_model;
+  j["lubrication_integration"] = lubrication_integration;
   j["lubrication_onset_over_a"] = lubrication_onset_over_a;
   j["lubrication_saturation_over_a"] = lubrication_saturation_over_a;
   j["L_over_a"] = length_over_a;

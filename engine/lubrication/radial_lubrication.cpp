@@ -59,8 +59,14 @@ double RadialLubrication::coefficient(double gap, double radius) const {
       const double f = (e - t[k - 1].first) / (t[k].first - t[k - 1].first);
       share = t[k - 1].second + f * (t[k].second - t[k - 1].second);
     }
+    // Brenner's lambda is per sphere speed U (F = 6 pi mu a U lambda); the
+    // coefficient multiplies the relative radial velocity w = 2U, so half that.
+    // Negative where the lattice alone resists more than the exact value (it
+    // does at small viscosity from about 0.07a up: docs/contacts.md): the
+    // correction then takes the excess off, and the pair's total is still the
+    // exact, positive resistance.
     const double excess = brenner_pair_resistance(e) - share;
-    return 6.0 * M_PI * params_.liquid_density * params_.viscosity * radius * std::max(0.0, excess);
+    return 3.0 * M_PI * params_.liquid_density * params_.viscosity * radius * excess;
   }
   return 1.5 * M_PI * params_.liquid_density * params_.viscosity * radius * radius *
          (1.0 / s - 1.0 / s0);
@@ -83,8 +89,14 @@ int RadialLubrication::apply(SphereSet& spheres, const PeriodicBox& box, double 
     Vec3& u_j = spheres.velocity[p.j];
     const double w = (u_j - u_i).dot(n);
     // Backward Euler in w: the force c w' uses the radial velocity at the end
-    // of the step, so w' = w / (1 + 2 c dt / m) has the sign of w.
-    const double w_after = w / (1.0 + 2.0 * c * dt / mass);
+    // of the step, so w' = w / (1 + 2 c dt / m) has the sign of w. Forward
+    // Euler (the paper's) uses w at the start and overshoots past 2 c dt / m = 1.
+    // A negative (calibrated) coefficient takes off resistance the lattice
+    // already over-counts: forward Euler, w (1 + |2 c dt / m|), keeps the sign
+    // of w at any dt, where backward Euler would not past |2 c dt / m| = 1.
+    const double decay = 2.0 * c * dt / mass;
+    const double w_after =
+        params_.explicit_euler || decay < 0 ? w * (1.0 - decay) : w / (1.0 + decay);
     const double half_change = 0.5 * (w - w_after);
     u_i += half_change * n;
     u_j -= half_change * n;

@@ -31,10 +31,17 @@ struct LubricationParams {
   // of a held IB pair, periodic-box offset removed, as (s/a, lambda_IB) points
   // in increasing s/a. When given, the coefficient below s0 is the exact
   // (Brenner) resistance minus the lattice's share,
-  //   c(s) = 6 pi rho nu a max(0, lambda_exact(s/a) - lambda_IB(s/a)),
+  //   c(s) = 3 pi rho nu a (lambda_exact(s/a) - lambda_IB(s/a))
+  // (lambda is per sphere speed U, F = 6 pi mu a U lambda; c multiplies the
+  // relative radial velocity 2U), negative where the lattice alone resists
+  // more than the exact value,
   // lambda_IB linear between points and held at the end values outside them,
   // instead of the Nguyen-Ladd (3/2) pi rho nu a^2 (1/s - 1/s0). Empty: Nguyen-Ladd.
   std::vector<std::pair<double, double>> lattice_share;
+  // Forward Euler in w, as the paper integrates it: w' = w (1 - 2 c dt / m),
+  // which reverses an approach once 2 c dt / m > 1. Offered only to measure
+  // what the paper's scheme does to aggregation; the default is implicit.
+  bool explicit_euler = false;
 
   void check() const;  // std::invalid_argument naming the field, value and allowed range
 };
@@ -49,8 +56,8 @@ class RadialLubrication {
 
   // Applies the lubrication impulse of one time step dt to the velocities of
   // all pairs closer than the onset gap, pair by pair, implicitly in each
-  // pair's radial relative velocity. Momentum is conserved exactly (equal and
-  // opposite impulses). Sphere masses m_p = (rho_p / rho) rho (4/3) pi a^3.
+  // pair's radial relative velocity (or explicitly, see explicit_euler). Momentum is conserved
+  // exactly (equal and opposite impulses). Sphere masses m_p = (rho_p / rho) rho (4/3) pi a^3.
   // Returns the number of pairs that interacted.
   int apply(SphereSet& spheres, const PeriodicBox& box, double dt) const;
 

@@ -444,7 +444,9 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
       {.viscosity = c.viscosity,
        .liquid_density = 1.0,
        .onset_gap = c.lubrication_onset_over_a,
-       .saturation_gap = c.lubrication_saturation_over_a});
+       .saturation_gap = c.lubrication_saturation_over_a,
+       .lattice_share = c.lubrication_lattice_share,
+       .explicit_euler = c.lubrication_integration == "explicit-paper"});
   std::unique_ptr<Liquid<Real>> liquid;
   if (modules.liquid) liquid = std::make_unique<Liquid<Real>>(c);
 

@@ -210,11 +210,11 @@ LubricationParams calibrated_a4() {
 }
 
 // The calibrated coefficient is the exact resistance minus the lattice's
-// share: at s = 0.05a, 6 pi rho nu a (12.71 - 6.51) with 12.71 Brenner's value
-// there (docs/contacts.md table, 12.7 also quoted in the issue).
+// share: at s = 0.05a, 3 pi rho nu a (12.71 - 6.51) per unit relative radial
+// velocity, with 12.71 Brenner's value there (docs/contacts.md table).
 TEST(RadialLubrication, CalibratedCoefficientIsExactMinusLatticeShare) {
   const RadialLubrication lub(calibrated_a4());
-  const double a = 4.0, unit = 6 * M_PI * (1.0 / 6.0) * a;
+  const double a = 4.0, unit = 3 * M_PI * (1.0 / 6.0) * a;
   EXPECT_NEAR(lub.coefficient(0.05 * a, a) / unit, 12.71 - 6.51, 0.01);
   // between points the share is linear: at 0.03a, 7.02 - (1/3)(0.51) = 6.85
   EXPECT_NEAR(lub.coefficient(0.03 * a, a) / unit + 6.85, brenner_pair_resistance(0.03), 1e-12);
@@ -223,6 +223,22 @@ TEST(RadialLubrication, CalibratedCoefficientIsExactMinusLatticeShare) {
   EXPECT_EQ(lub.coefficient(0.21 * a, a), 0.0);
   // closer is stiffer
   EXPECT_GT(lub.coefficient(0.01 * a, a), lub.coefficient(0.02 * a, a));
+}
+
+// Brenner's definition, worked by hand: two spheres each moving at U towards
+// the other feel F = 6 pi mu a U lambda each; the correction must add
+// 6 pi mu a U (lambda_exact - lambda_IB), i.e. an impulse F dt on each sphere
+// in a short step (implicit update, relative order 2 c dt / m < 1e-6 here).
+TEST(RadialLubrication, CalibratedForceOnEachSphereIsBrennersPerSphereSpeed) {
+  const RadialLubrication lub(calibrated_a4());
+  const double nu = 1.0 / 6.0, U = 1e-3, dt = 1e-4;
+  const Vec3 n = Vec3(1, 2, -2).normalized();
+  auto pair = pair_at_gap(0.05 * kA, n, U * n, -U * n);
+  const double mass = pair.mass();
+  lub.apply(pair, kBox, dt);
+  const double force_on_0 = -(pair.velocity[0] - U * n).dot(n) * mass / dt;
+  const double expected = 6 * M_PI * nu * kA * U * (brenner_pair_resistance(0.05) - 6.51);
+  EXPECT_NEAR(force_on_0 / expected, 1.0, 1e-5);
 }
 
 TEST(RadialLubrication, CalibratedNeverReversesTheApproach) {
@@ -235,6 +251,45 @@ TEST(RadialLubrication, CalibratedNeverReversesTheApproach) {
     const Vec3 du1 = pair.velocity[1] - pair.velocity[0];
     EXPECT_LT(du1.dot(n), 0.0) << "dt " << dt;
     EXPECT_LT(std::abs(du1.dot(n)), std::abs(du0.dot(n)));
+  }
+}
+
+// The paper's forward Euler, worked by hand: w' = w (1 - 2 c dt / m). With
+// 2 c dt / m = 1.5 at s1 an approach turns into a separation at half the speed,
+// which the default implicit update, w' = w / 2.5, never does.
+TEST(RadialLubrication, ExplicitPaperSchemeReversesWhereImplicitDoesNot) {
+  LubricationParams p{.viscosity = kNu};
+  const RadialLubrication implicit_lub(p);
+  p.explicit_euler = true;
+  const RadialLubrication explicit_lub(p);
+  const Vec3 n = Vec3(0, 0, 1);
+  auto pair = pair_at_gap(kS1, n, Vec3(0, 0, 0.01), Vec3(0, 0, -0.01));
+  const double dt = 1.5 * pair.mass() / (2 * implicit_lub.coefficient(kS1, kA));
+  auto explicit_pair = pair;
+  implicit_lub.apply(pair, kBox, dt);
+  explicit_lub.apply(explicit_pair, kBox, dt);
+  EXPECT_NEAR((pair.velocity[1] - pair.velocity[0]).dot(n), -0.02 / 2.5, 1e-15);
+  EXPECT_NEAR((explicit_pair.velocity[1] - explicit_pair.velocity[0]).dot(n), +0.01, 1e-15);
+}
+
+// Where the lattice alone resists more than the exact value the correction is
+// negative, c = 3 pi rho nu a (lambda_exact - lambda_IB) < 0, and takes the
+// excess off; the approach is still never reversed, at any dt.
+TEST(RadialLubrication, CalibratedTakesOffWhatTheLatticeOvercounts) {
+  // lambda_IB 6.41 at 0.15a, above Brenner's 5.58 (a = 4, nu = 0.02, measured)
+  const RadialLubrication lub({.viscosity = 0.02, .lattice_share = {{0.1, 8.13}, {0.15, 6.41}}});
+  const double a = 4.0;
+  EXPECT_NEAR(lub.coefficient(0.15 * a, a) / (3 * M_PI * 0.02 * a),
+              brenner_pair_resistance(0.15) - 6.41, 1e-12);
+  EXPECT_LT(lub.coefficient(0.15 * a, a), 0.0);
+  const Vec3 n = Vec3(0.3, -1, 0.2).normalized();
+  for (double dt : {1.0, 1e4, 1e8}) {
+    auto pair = pair_at_gap(0.15 * kA, n, Vec3(0.03, 0.01, 0), Vec3(-0.02, 0, 0.01));
+    const double w0 = (pair.velocity[1] - pair.velocity[0]).dot(n);
+    lub.apply(pair, kBox, dt);
+    const double w1 = (pair.velocity[1] - pair.velocity[0]).dot(n);
+    EXPECT_LT(w1, 0.0) << "dt " << dt;
+    EXPECT_GT(std::abs(w1), std::abs(w0)) << "dt " << dt;
   }
 }
 

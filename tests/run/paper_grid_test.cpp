@@ -56,7 +56,9 @@ TEST(PaperGrid, EveryPointParsesOrIsRefusedWithWhatWouldWork) {
       }
     }
     EXPECT_EQ(refused, fidelity == "draft" ? 48 : 0) << fidelity;
-    if (fidelity == "draft") EXPECT_EQ(refused_re, (std::set<double>{48, 72}));
+    if (fidelity == "draft") {
+      EXPECT_EQ(refused_re, (std::set<double>{48, 72}));
+    }
   }
 }
 

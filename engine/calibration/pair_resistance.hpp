@@ -1,0 +1,92 @@
+#pragma once
+// The lattice's own radial resistance of a close pair of immersed-boundary
+// spheres, measured once per (a, viscosity, immersed-boundary settings) like
+// the hydrodynamic radius, so that the lubrication correction adds only what
+// the lattice misses (docs/contacts.md, "Calibrated close-pair coefficient").
+//
+// Two spheres of hydrodynamic radius a sit at surface gap s on the x axis of a
+// periodic box of 16a x 8a x 8a and are held there while moving at +-V along
+// their line of centres (towards each other, or apart); the liquid starts at
+// rest and the run goes on until the force is steady. No lubrication acts.
+// lambda = F / (6 pi rho nu a V) is compared with Brenner's exact value for an
+// isolated pair. The periodic images add a far-field part that hardly changes
+// over s << L; it is read off at the largest gap measured (s = 0.5a, where the
+// lattice resolves the gap by 2 dx or more and the pair is well described) as
+// lambda_measured - lambda_exact and removed at every gap:
+//   lambda_IB(s) = lambda_measured(s) - box_offset.
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace flocsim::calibration {
+
+struct PairResistanceSettings {
+  double viscosity = 1.0 / 6.0;
+  double marker_spacing = 0.7;
+  int iterations = 2;
+  double box_over_a = 16;   // box 16a x 8a x 8a (rounded to whole cells)
+  double reynolds = 0.01;   // 2 a V / nu: creeping flow
+  double tolerance = 2e-6;  // steady: relative change of lambda per 200 steps
+  long max_steps = 1000000;
+};
+
+// One held pair at gap s (in units of a); returns lambda_measured and the steps
+// taken. Double precision, the shipped hydrodynamic-radius calibration.
+struct PairResistancePoint {
+  double gap_over_a = 0;
+  double lambda_measured = 0;  // box images included
+  double lambda_exact = 0;     // Brenner (1961)
+  long steps = 0;
+};
+PairResistancePoint measure_pair_resistance(double hydrodynamic_radius, double gap_over_a,
+                                            bool separating, const PairResistanceSettings& s);
+
+// The gaps a calibration measures by default (units of a); the last is where
+// the box offset is read.
+std::vector<double> default_pair_gaps();
+
+struct PairResistanceEntry {
+  double hydrodynamic_radius = 0;
+  double viscosity = 0;
+  double marker_spacing = 0.7;
+  int iterations = 2;
+  int box = 0;  // length along the line of centres (dx); the cross-section is half
+  bool separating = false;
+  double box_offset = 0;                    // lambda_measured - lambda_exact at the largest gap
+  std::vector<PairResistancePoint> points;  // increasing gap_over_a
+  // lambda_IB(s/a) = lambda_measured - box_offset, linear between points, held
+  // at the end values outside them.
+  double lattice_share(double gap_over_a) const;
+};
+
+PairResistanceEntry calibrate_pair_resistance(
+    double hydrodynamic_radius, const std::vector<double>& gaps, bool separating,
+    const PairResistanceSettings& s, void (*progress)(const PairResistancePoint&) = nullptr);
+
+class PairResistanceTable {
+ public:
+  static PairResistanceTable load(const std::string& filename);
+  static PairResistanceTable parse(const std::string& json_text, const std::string& origin);
+  // engine/calibration/pair_resistance.json at build time, compiled in.
+  static const PairResistanceTable& shipped();
+  void save(const std::string& filename) const;
+  // Replaces an entry of the same a, nu, scheme and direction.
+  void add(const PairResistanceEntry& entry);
+  const std::vector<PairResistanceEntry>& entries() const { return entries_; }
+  // Whether an approaching entry exists for this a and scheme.
+  bool has(double hydrodynamic_radius, double marker_spacing = 0.7, int iterations = 2) const;
+  // lambda_IB at the gaps of the calibration, (s/a, lambda_IB) in increasing
+  // s/a, for a at nu: between the two approaching entries whose viscosities
+  // bracket nu, linear in log(nu) at every gap; outside the calibrated
+  // viscosities the nearest entry (no extrapolation). Throws std::out_of_range
+  // naming what exists when no entry has this a and scheme.
+  std::vector<std::pair<double, double>> lattice_share(double hydrodynamic_radius, double viscosity,
+                                                       double marker_spacing = 0.7,
+                                                       int iterations = 2) const;
+  std::string note;
+
+ private:
+  std::vector<PairResistanceEntry> entries_;
+};
+
+}  // namespace flocsim::calibration
