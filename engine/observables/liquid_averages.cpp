@@ -39,9 +39,9 @@ LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
   mark_solid_cells(e, spheres.position, spheres.radius, solid);
   const double body_x = fluid.body_force().x;
   const Real* field_x = fluid.has_force_field() ? fluid.force_field(0) : nullptr;
-  double velocity_sum = 0, momentum = 0, mass = 0;
+  double velocity_sum = 0, all_cells_sum = 0, momentum = 0, mass = 0;
   long liquid = 0;
-#pragma omp parallel reduction(+ : velocity_sum, momentum, mass, liquid)
+#pragma omp parallel reduction(+ : velocity_sum, all_cells_sum, momentum, mass, liquid)
   {
     std::vector<double> rho(static_cast<std::size_t>(e.nx)), ux(rho.size()), uy(rho.size()),
         uz(rho.size());
@@ -55,9 +55,11 @@ LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
       for (int x = 0; x < e.nx; ++x) {
         momentum += rho[x] * ux[x] - 0.5 * body_x;
         mass += rho[x];
-        if (solid[static_cast<std::size_t>(row * e.nx + x)]) continue;
         const double field = field_x ? static_cast<double>(field_x[base + x]) : 0.0;
-        velocity_sum += ux[x] + 0.5 * field / rho[x];
+        const double u = ux[x] + 0.5 * field / rho[x];
+        all_cells_sum += u;
+        if (solid[static_cast<std::size_t>(row * e.nx + x)]) continue;
+        velocity_sum += u;
         ++liquid;
       }
     }
@@ -65,6 +67,7 @@ LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
   LiquidAverages out;
   out.liquid_cells = liquid;
   out.mean_velocity_x = liquid > 0 ? velocity_sum / static_cast<double>(liquid) : 0.0;
+  out.mean_velocity_x_all_cells = all_cells_sum / static_cast<double>(e.cells());
   out.lattice_momentum_x = momentum;
   out.mass = mass;
   return out;

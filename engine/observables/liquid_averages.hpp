@@ -19,6 +19,11 @@ struct LiquidAverages {
   // plus the per-cell force field).
   double mean_velocity_x = 0;
   long liquid_cells = 0;
+  // The same over every cell, the liquid inside the spheres included: the
+  // other reading of <u> (docs/validation.md, "Which <u>"). If the inside
+  // liquid moves with its sphere, (<u>_all - <u_p>) = (1 - phi)(<u> - <u_p>),
+  // so a drag built on it reads F / (1 - phi).
+  double mean_velocity_x_all_cells = 0;
   // sum over every cell of sum_i c_ix f_i: the lattice momentum without any
   // half-force shift (what the momentum balance conserves, sphere_dynamics.hpp).
   double lattice_momentum_x = 0;

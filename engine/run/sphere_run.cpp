@@ -7,6 +7,7 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -79,7 +80,7 @@ std::vector<std::string> columns_of(const SceneModules& m) {
                                    "collisions"};
   if (m.liquid)
     cols.insert(cols.end(), {"U_over_Uinf", "U", "F", "Re", "liquid_velocity", "sphere_velocity",
-                             "momentum_balance"});
+                             "momentum_balance", "liquid_velocity_all_cells", "F_all_cells"});
   return cols;
 }
 
@@ -294,6 +295,11 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, RunSt
     std::string name = "/series/" + s.series.names[col];
     // checkpoints written before C_sph had its present name
     if (s.series.names[col] == "C_sph" && !f.exists(name)) name = "/series/contacts_per_sphere";
+    // columns added after the checkpoint was written: unknown (NaN) so far
+    if (!f.exists(name) && col > 0) {
+      s.series.data[col].assign(s.series.data[0].size(), std::numeric_limits<double>::quiet_NaN());
+      continue;
+    }
     s.series.data[col] = f.read<double>(name);
   }
   s.size_distribution_sum = f.read<double>("/size_distribution_sum");
@@ -586,11 +592,16 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
           s.momentum_initial_set = true;
         }
         const double drift = modules.spheres_move ? balance - s.momentum_initial : 0.0;
+        // the other reading of <u>: every cell, the liquid inside the spheres too
+        const double U_all = observables::superficial_slip_velocity(
+            l.mean_velocity_x_all_cells, sphere_mean.x(), c.phi_realised);
+        const double body = liquid->dynamics.external.liquid_body_force.x();
         row.insert(row.end(),
                    {U / c.settling_velocity, U,
-                    observables::dimensionless_drag(liquid->dynamics.external.liquid_body_force.x(),
-                                                    a, c.phi_realised, c.viscosity, U),
-                    U * 2 * a / c.viscosity, l.mean_velocity_x, sphere_mean.x(), drift});
+                    observables::dimensionless_drag(body, a, c.phi_realised, c.viscosity, U),
+                    U * 2 * a / c.viscosity, l.mean_velocity_x, sphere_mean.x(), drift,
+                    l.mean_velocity_x_all_cells,
+                    observables::dimensionless_drag(body, a, c.phi_realised, c.viscosity, U_all)});
         worst_momentum_drift = std::max(worst_momentum_drift, std::abs(drift));
       }
       for (std::size_t col = 0; col < row.size(); ++col) s.series.data[col].push_back(row[col]);
@@ -689,6 +700,11 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     obs["U_over_Uinf"] = steady(statistics_window(s, "U_over_Uinf"));
     obs["U"] = steady(statistics_window(s, "U"));
     obs["F"] = steady(statistics_window(s, "F"));
+    // F with <u> over every cell (docs/validation.md, "Which <u>"); F is the
+    // liquid-only reading flocsim reports
+    const auto f_all = statistics_window(s, "F_all_cells");
+    if (std::none_of(f_all.begin(), f_all.end(), [](double v) { return std::isnan(v); }))
+      obs["F_all_cells"] = steady(f_all);
     obs["Re"] = steady(statistics_window(s, "Re"));
     const double phi = c.phi_realised;
     const double re = obs["Re"]["mean"].get<double>();

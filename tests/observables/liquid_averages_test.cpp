@@ -81,6 +81,11 @@ void prescribed_field(double tolerance) {
   const LiquidAverages l = liquid_averages(fluid, s, scratch);
   EXPECT_EQ(l.liquid_cells, kExtent.cells() - solid_cells);
   EXPECT_NEAR(l.mean_velocity_x, U0, tolerance * U0);
+  // every cell: U0 outside, V inside, weighted by their counts
+  const double all_cells = (U0 * static_cast<double>(kExtent.cells() - solid_cells) +
+                            V * static_cast<double>(solid_cells)) /
+                           static_cast<double>(kExtent.cells());
+  EXPECT_NEAR(l.mean_velocity_x_all_cells, all_cells, tolerance * std::abs(all_cells));
   // raw momentum: sum rho u minus half of every force applied
   const double expected = U0 * static_cast<double>(kExtent.cells() - solid_cells) +
                           V * static_cast<double>(solid_cells) -
