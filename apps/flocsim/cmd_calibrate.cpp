@@ -30,8 +30,9 @@ struct CalibrateOptions {
   std::vector<int> boxes;
   std::vector<double> chis = {0.35, 0.5, 0.7};
   double viscosity = 1.0 / 6.0;
-  double marker_spacing = 0.7;
-  int iterations = 2;
+  double marker_spacing = immersed_boundary::kPaperScheme.marker_spacing;
+  int sweeps = immersed_boundary::kPaperScheme.sweeps;
+  std::string kernel = "roma3";
   double tolerance = 1e-6;
   std::string table;
   bool close_pairs = false;
@@ -39,6 +40,10 @@ struct CalibrateOptions {
   std::vector<double> gaps;
   double pair_box_over_a = 16;
 };
+
+immersed_boundary::Scheme scheme_of(const CalibrateOptions& o) {
+  return {o.marker_spacing, o.sweeps, *immersed_boundary::kernel_from_name(o.kernel)};
+}
 
 void print_pair_point(const calibration::PairResistancePoint& p) {
   std::printf("  s/a = %6.3f  lambda = %9.4f  exact %9.4f  steps %7ld\n", p.gap_over_a,
@@ -58,13 +63,12 @@ int run_pair_calibration(const CalibrateOptions& o) {
       "gap. Made by `flocsim calibrate --close-pairs`; see docs/contacts.md.";
   calibration::PairResistanceSettings s;
   s.viscosity = o.viscosity;
-  s.marker_spacing = o.marker_spacing;
-  s.iterations = o.iterations;
+  s.scheme = scheme_of(o);
   s.box_over_a = o.pair_box_over_a;
   const auto gaps = o.gaps.empty() ? calibration::default_pair_gaps() : o.gaps;
   for (double a : o.radii) {
-    std::printf("close pair, a = %g dx, nu = %g, %s:\n", a, o.viscosity,
-                o.separating ? "separating" : "approaching");
+    std::printf("close pair, a = %g dx, nu = %g, %s, %s:\n", a, o.viscosity,
+                o.separating ? "separating" : "approaching", s.scheme.describe().c_str());
     const auto e =
         calibration::calibrate_pair_resistance(a, gaps, o.separating, s, print_pair_point);
     std::printf("=> box offset %+.4f (at s/a = %g); lambda_IB = measured - offset\n", e.box_offset,
@@ -89,9 +93,9 @@ int run_calibrate(const CalibrateOptions& o) {
   calibration::CalibrationTable table;
   if (std::filesystem::exists(o.table)) table = calibration::CalibrationTable::load(o.table);
   table.note =
-      "Hydrodynamic radius a of immersed-boundary spheres (Roma 3-point kernel, multi-direct "
-      "forcing) "
-      "against input radius a_g. Made by `flocsim calibrate`: one fixed sphere in periodic cubes "
+      "Hydrodynamic radius a of immersed-boundary spheres (multi-direct forcing; each entry names "
+      "its marker spacing, sweeps ('iterations') and kernel) against input radius a_g. Made by "
+      "`flocsim calibrate`: one fixed sphere in periodic cubes "
       "(simple cubic arrays), creeping flow (U = 1e-4, Re < 0.02), steady to 1e-6 per 100 steps; a "
       "is "
       "the radius for which F/(6 pi nu a U) equals the Sangani-Acrivos (1982) K(2a/L), averaged "
@@ -99,14 +103,14 @@ int run_calibrate(const CalibrateOptions& o) {
       "boxes listed in each entry. See docs/immersed-boundary.md.";
   calibration::ArrayDragSettings s;
   s.viscosity = o.viscosity;
-  s.marker_spacing = o.marker_spacing;
-  s.iterations = o.iterations;
+  s.scheme = scheme_of(o);
   s.tolerance = o.tolerance;
   for (double a : o.radii) {
     std::vector<int> boxes = o.boxes;
     if (boxes.empty())
       for (double chi : o.chis) boxes.push_back(static_cast<int>(std::lround(2.0 * a / chi)));
-    std::printf("hydrodynamic radius a = %g dx, nu = %g:\n", a, o.viscosity);
+    std::printf("hydrodynamic radius a = %g dx, nu = %g, %s:\n", a, o.viscosity,
+                s.scheme.describe().c_str());
     const auto entry = calibration::calibrate_input_radius(a, boxes, s, print_run);
     double spread = 0;
     for (const auto& c : entry.checks)
@@ -134,9 +138,11 @@ const bool registered = register_command(
                       "cube edges L (dx); default: chi = 2a/L of 0.35, 0.5, 0.7")
            ->check(CLI::Range(8, 400));
        cmd.add_option("--marker-spacing", o->marker_spacing, "marker spacing (dx)")
-           ->check(CLI::Range(0.3, 1.0));
-       cmd.add_option("--iterations", o->iterations, "direct-forcing iterations per step")
+           ->check(CLI::Range(0.3, 1.5));
+       cmd.add_option("--sweeps,--iterations", o->sweeps, "direct-forcing sweeps per step")
            ->check(CLI::Range(1, 20));
+       cmd.add_option("--kernel", o->kernel, "interpolation/spreading kernel")
+           ->check(CLI::IsMember(immersed_boundary::kernel_names()));
        cmd.add_option("--tolerance", o->tolerance,
                       "steady state: relative change of U per 100 steps")
            ->check(CLI::Range(1e-10, 1e-3));

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "engine/calibration/shipped_table.hpp"
+#include "engine/calibration/table_scheme.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/spheres/sphere_set.hpp"
@@ -66,8 +67,7 @@ double hydrodynamic_radius_from_drag(double force, double superficial_velocity, 
 ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
                                         const ArrayDragSettings& settings) {
   lattice::FluidLattice<double> fluid({box, box, box}, {settings.viscosity, 0.25});
-  immersed_boundary::ImmersedBoundary<double> ib(
-      {input_radius, settings.marker_spacing, settings.iterations, false});
+  immersed_boundary::ImmersedBoundary<double> ib({input_radius, settings.scheme, false});
   spheres::SphereSet sphere;
   sphere.radius = input_radius;
   sphere.resize(1);
@@ -120,8 +120,7 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
   CalibrationEntry e;
   e.hydrodynamic_radius = hydrodynamic_radius;
   e.viscosity = settings.viscosity;
-  e.marker_spacing = settings.marker_spacing;
-  e.iterations = settings.iterations;
+  e.scheme = settings.scheme;
   double ag = hydrodynamic_radius - 0.3;  // typical offset, refined below
   for (int pass = 0; pass < 3; ++pass) {
     e.checks.clear();
@@ -157,9 +156,7 @@ nlohmann::json to_json(const ArrayDragResult& r, double viscosity) {
 void CalibrationTable::add(const CalibrationEntry& entry) {
   std::erase_if(entries_, [&](const CalibrationEntry& e) {
     return std::abs(e.hydrodynamic_radius - entry.hydrodynamic_radius) < 1e-6 &&
-           std::abs(e.viscosity - entry.viscosity) < 1e-9 &&
-           std::abs(e.marker_spacing - entry.marker_spacing) < 1e-9 &&
-           e.iterations == entry.iterations;
+           std::abs(e.viscosity - entry.viscosity) < 1e-9 && e.scheme == entry.scheme;
   });
   entries_.push_back(entry);
   std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) {
@@ -176,12 +173,12 @@ void CalibrationTable::save(const std::string& filename) const {
   for (const auto& e : entries_) {
     nlohmann::json checks = nlohmann::json::array();
     for (const auto& c : e.checks) checks.push_back(to_json(c, e.viscosity));
-    j["entries"].push_back({{"hydrodynamic_radius", e.hydrodynamic_radius},
-                            {"viscosity", e.viscosity},
-                            {"input_radius", e.input_radius},
-                            {"marker_spacing", e.marker_spacing},
-                            {"iterations", e.iterations},
-                            {"checks", checks}});
+    nlohmann::json je = {{"hydrodynamic_radius", e.hydrodynamic_radius},
+                         {"viscosity", e.viscosity},
+                         {"input_radius", e.input_radius},
+                         {"checks", checks}};
+    write_scheme(je, e.scheme);
+    j["entries"].push_back(je);
   }
   std::ofstream out(filename);
   if (!out) throw std::runtime_error("cannot write calibration table " + filename);
@@ -216,8 +213,7 @@ CalibrationTable CalibrationTable::parse(const std::string& json_text, const std
     e.hydrodynamic_radius = je.at("hydrodynamic_radius").get<double>();
     e.viscosity = je.at("viscosity").get<double>();
     e.input_radius = je.at("input_radius").get<double>();
-    e.marker_spacing = je.at("marker_spacing").get<double>();
-    e.iterations = je.at("iterations").get<int>();
+    e.scheme = scheme_from_entry(je, origin);
     for (const auto& jc : je.value("checks", nlohmann::json::array())) {
       ArrayDragResult r;
       r.input_radius = e.input_radius;
@@ -234,31 +230,40 @@ CalibrationTable CalibrationTable::parse(const std::string& json_text, const std
 }
 
 namespace {
-// An entry for this a made with this marker spacing and number of sweeps.
-bool same_scheme(const CalibrationEntry& e, double hydrodynamic_radius, double marker_spacing,
-                 int iterations) {
-  return std::abs(e.hydrodynamic_radius - hydrodynamic_radius) <= 1e-6 &&
-         std::abs(e.marker_spacing - marker_spacing) <= 1e-9 && e.iterations == iterations;
+// An entry for this a made with this immersed-boundary scheme.
+bool same_scheme(const CalibrationEntry& e, double hydrodynamic_radius,
+                 const immersed_boundary::Scheme& scheme) {
+  return std::abs(e.hydrodynamic_radius - hydrodynamic_radius) <= 1e-6 && e.scheme == scheme;
 }
 }  // namespace
 
+bool CalibrationTable::has(double hydrodynamic_radius,
+                           const immersed_boundary::Scheme& scheme) const {
+  return std::any_of(entries_.begin(), entries_.end(), [&](const CalibrationEntry& e) {
+    return same_scheme(e, hydrodynamic_radius, scheme);
+  });
+}
+
 const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, double viscosity,
-                                                 double marker_spacing, int iterations) const {
+                                                 const immersed_boundary::Scheme& scheme) const {
   const CalibrationEntry* best = nullptr;
   for (const auto& e : entries_) {
-    if (!same_scheme(e, hydrodynamic_radius, marker_spacing, iterations)) continue;
+    if (!same_scheme(e, hydrodynamic_radius, scheme)) continue;
     if (!best || std::abs(std::log(e.viscosity / viscosity)) <
                      std::abs(std::log(best->viscosity / viscosity)))
       best = &e;
   }
   if (!best) {
     std::ostringstream msg;
-    msg << "no hydrodynamic-radius calibration for a = " << hydrodynamic_radius
-        << " dx (marker spacing " << marker_spacing << ", " << iterations
-        << " iterations); calibrated:";
-    for (const auto& e : entries_)
-      msg << " a = " << e.hydrodynamic_radius << " (nu = " << e.viscosity << ", spacing "
-          << e.marker_spacing << ", " << e.iterations << " it)";
+    msg << "no hydrodynamic-radius calibration for a = " << hydrodynamic_radius << " dx with "
+        << scheme.describe() << "; calibrated:";
+    std::vector<std::string> seen;
+    for (const auto& e : entries_) {
+      std::ostringstream one;
+      one << " a = " << e.hydrodynamic_radius << " (" << e.scheme.describe() << ")";
+      if (std::find(seen.begin(), seen.end(), one.str()) == seen.end()) seen.push_back(one.str());
+    }
+    for (const auto& one : seen) msg << one;
     msg << ". Run `flocsim calibrate`.";
     throw std::out_of_range(msg.str());
   }
@@ -266,12 +271,11 @@ const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, dou
 }
 
 double CalibrationTable::input_radius(double hydrodynamic_radius, double viscosity,
-                                      double marker_spacing, int iterations) const {
-  const CalibrationEntry& nearest =
-      lookup(hydrodynamic_radius, viscosity, marker_spacing, iterations);
+                                      const immersed_boundary::Scheme& scheme) const {
+  const CalibrationEntry& nearest = lookup(hydrodynamic_radius, viscosity, scheme);
   const CalibrationEntry *below = nullptr, *above = nullptr;
   for (const auto& e : entries_) {
-    if (!same_scheme(e, hydrodynamic_radius, marker_spacing, iterations)) continue;
+    if (!same_scheme(e, hydrodynamic_radius, scheme)) continue;
     if (e.viscosity <= viscosity && (!below || e.viscosity > below->viscosity)) below = &e;
     if (e.viscosity >= viscosity && (!above || e.viscosity < above->viscosity)) above = &e;
   }

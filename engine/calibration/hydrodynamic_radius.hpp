@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/immersed_boundary/scheme.hpp"
+
 namespace flocsim::calibration {
 
 // Sangani & Acrivos (1982) eq. 60, 31-term series in chi = 2a/L, for the
@@ -29,8 +31,7 @@ double hasimoto_drag(double chi);
 
 struct ArrayDragSettings {
   double viscosity = 1.0 / 6.0;  // lattice viscosity of the calibration runs
-  double marker_spacing = 0.7;
-  int iterations = 2;
+  immersed_boundary::Scheme scheme;
   double superficial_velocity = 1e-4;  // sets the body force through the reference K; Re << 1
   double tolerance = 1e-6;             // relative change of U per 100 steps at steady state
   long max_steps = 400000;
@@ -62,8 +63,7 @@ struct CalibrationEntry {
   double hydrodynamic_radius = 0;  // a (dx)
   double viscosity = 0;
   double input_radius = 0;  // a_g (dx)
-  double marker_spacing = 0.7;
-  int iterations = 2;
+  immersed_boundary::Scheme scheme;
   std::vector<ArrayDragResult> checks;  // the runs with the final a_g
 };
 
@@ -88,18 +88,20 @@ class CalibrationTable {
   void add(const CalibrationEntry& entry);
   const std::vector<CalibrationEntry>& entries() const { return entries_; }
   // The input radius for hydrodynamic radius a at viscosity nu: the entry with
-  // the same a (within 1e-6 dx), marker spacing and iterations whose viscosity
+  // the same a (within 1e-6 dx) and immersed-boundary scheme whose viscosity
   // is nearest to nu. Throws std::out_of_range, naming what exists, when no
-  // entry has that a.
+  // entry has that a and scheme.
   const CalibrationEntry& lookup(double hydrodynamic_radius, double viscosity,
-                                 double marker_spacing = 0.7, int iterations = 2) const;
-  // The input radius for a at nu: between the two entries (same a, spacing and
-  // iterations) whose viscosities bracket nu, a_g interpolated linearly in
+                                 const immersed_boundary::Scheme& scheme = {}) const;
+  // Whether any entry has this a and scheme.
+  bool has(double hydrodynamic_radius, const immersed_boundary::Scheme& scheme) const;
+  // The input radius for a at nu: between the two entries (same a and
+  // scheme) whose viscosities bracket nu, a_g interpolated linearly in
   // log(nu) (the offset a - a_g varies smoothly with log nu: 0.431 to 0.388 dx
   // from nu = 0.005 to 1/6 at a = 6); outside the calibrated viscosities, the
   // nearest entry's a_g (no extrapolation). Throws like lookup().
-  double input_radius(double hydrodynamic_radius, double viscosity, double marker_spacing = 0.7,
-                      int iterations = 2) const;
+  double input_radius(double hydrodynamic_radius, double viscosity,
+                      const immersed_boundary::Scheme& scheme = {}) const;
   std::string note;  // how the table was made
 
  private:

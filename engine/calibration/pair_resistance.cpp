@@ -9,54 +9,84 @@
 
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/calibration/shipped_pair_table.hpp"
+#include "engine/calibration/table_scheme.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lubrication/two_sphere_resistance.hpp"
 
 namespace flocsim::calibration {
 
+namespace {
+
+// Two spheres of hydrodynamic radius a held on the x axis of a periodic box
+// L x L/2 x L/2, moving along their line of centres at +-V, without lubrication.
+class HeldPair {
+ public:
+  HeldPair(double a, bool separating, const PairResistanceSettings& set)
+      : a_(a),
+        nu_(set.viscosity),
+        box_(static_cast<int>(std::lround(set.box_over_a * a / 2)) * 2),
+        towards_(separating ? -1.0 : 1.0),
+        V_(0.5 * set.reynolds * set.viscosity / a),
+        set_(set),
+        fluid_({box_, box_ / 2, box_ / 2}, {set.viscosity, 0.25}),
+        ib_({CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme), set.scheme,
+             false}) {
+    fluid_.initialise_equilibrium([](int, int, int) { return lattice::Macroscopic{}; });
+    pair_.radius = a;
+    pair_.resize(2);
+    pair_.velocity[0] = {towards_ * V_, 0, 0};
+    pair_.velocity[1] = {-towards_ * V_, 0, 0};
+  }
+
+  // Moves the pair to gap s and runs until the force is steady.
+  PairResistancePoint measure(double gap_over_a) {
+    // off the lattice's symmetry planes, so that no marker sits on a node by design
+    const double cx = 0.5 * box_, cy = 0.25 * box_ + 0.37, cz = 0.25 * box_ + 0.21;
+    pair_.position[0] = {cx - a_ - 0.5 * gap_over_a * a_, cy, cz};
+    pair_.position[1] = {cx + a_ + 0.5 * gap_over_a * a_, cy, cz};
+    PairResistancePoint p{.gap_over_a = gap_over_a,
+                          .lambda_exact = lubrication::brenner_pair_resistance(gap_over_a)};
+    double last = 0;
+    int quiet_checks = 0;  // consecutive checks below the tolerance
+    for (long step = 1; step <= set_.max_steps; ++step) {
+      ib_.apply(fluid_, pair_);
+      fluid_.step();
+      if (step % 200 != 0) continue;
+      // the force on sphere 0 opposes its motion, which is +x when approaching
+      const double lambda = -towards_ * ib_.force()[0].x() / (6 * M_PI * nu_ * a_ * V_);
+      if (!std::isfinite(lambda))
+        throw std::runtime_error("pair resistance: the measurement blew up at gap " +
+                                 std::to_string(gap_over_a) + " a");
+      p.lambda_measured = lambda;
+      p.steps = step;
+      quiet_checks =
+          std::abs(lambda - last) < set_.tolerance * std::abs(lambda) ? quiet_checks + 1 : 0;
+      if (step > 1000 && quiet_checks >= 3) return p;
+      last = lambda;
+    }
+    throw std::runtime_error("pair resistance: not steady after " + std::to_string(set_.max_steps) +
+                             " steps at gap " + std::to_string(gap_over_a) + " a");
+  }
+
+  int box() const { return box_; }
+
+ private:
+  double a_, nu_;
+  int box_;
+  double towards_, V_;
+  PairResistanceSettings set_;
+  lattice::FluidLattice<double> fluid_;
+  immersed_boundary::ImmersedBoundary<double> ib_;
+  spheres::SphereSet pair_;
+};
+
+}  // namespace
+
 PairResistancePoint measure_pair_resistance(double a, double gap_over_a, bool separating,
                                             const PairResistanceSettings& set) {
-  const int box = static_cast<int>(std::lround(set.box_over_a * a / 2)) * 2;
-  const double nu = set.viscosity;
-  lattice::FluidLattice<double> fluid({box, box / 2, box / 2}, {nu, 0.25});
-  fluid.initialise_equilibrium([](int, int, int) { return lattice::Macroscopic{}; });
-  const double a_g =
-      CalibrationTable::shipped().input_radius(a, nu, set.marker_spacing, set.iterations);
-  immersed_boundary::ImmersedBoundary<double> ib({a_g, set.marker_spacing, set.iterations, false});
-  spheres::SphereSet pair;
-  pair.radius = a;
-  pair.resize(2);
-  const double V = 0.5 * set.reynolds * nu / a;
-  // off the lattice's symmetry planes, so that no marker sits on a node by design
-  const double cx = 0.5 * box, cy = 0.25 * box + 0.37, cz = 0.25 * box + 0.21;
-  pair.position[0] = {cx - a - 0.5 * gap_over_a * a, cy, cz};
-  pair.position[1] = {cx + a + 0.5 * gap_over_a * a, cy, cz};
-  const double towards = separating ? -1.0 : 1.0;
-  pair.velocity[0] = {towards * V, 0, 0};
-  pair.velocity[1] = {-towards * V, 0, 0};
-  PairResistancePoint p{.gap_over_a = gap_over_a,
-                        .lambda_exact = lubrication::brenner_pair_resistance(gap_over_a)};
-  double last = 0;
-  int quiet_checks = 0;  // consecutive checks below the tolerance
-  for (long step = 1; step <= set.max_steps; ++step) {
-    ib.apply(fluid, pair);
-    fluid.step();
-    if (step % 200 != 0) continue;
-    // the force on sphere 0 opposes its motion, which is +x when approaching
-    const double lambda = -towards * ib.force()[0].x() / (6 * M_PI * nu * a * V);
-    if (!std::isfinite(lambda))
-      throw std::runtime_error("pair resistance: the measurement blew up at gap " +
-                               std::to_string(gap_over_a) + " a");
-    p.lambda_measured = lambda;
-    p.steps = step;
-    quiet_checks =
-        std::abs(lambda - last) < set.tolerance * std::abs(lambda) ? quiet_checks + 1 : 0;
-    if (step > 1000 && quiet_checks >= 3) return p;
-    last = lambda;
-  }
-  throw std::runtime_error("pair resistance: not steady after " + std::to_string(set.max_steps) +
-                           " steps at gap " + std::to_string(gap_over_a) + " a");
+  HeldPair pair(a, separating, set);
+  return pair.measure(gap_over_a);
 }
 
 std::vector<double> default_pair_gaps() {
@@ -85,14 +115,14 @@ PairResistanceEntry calibrate_pair_resistance(double a, const std::vector<double
   for (std::size_t k = 0; k < gaps.size(); ++k)
     if (!(gaps[k] > 0) || (k > 0 && gaps[k] <= gaps[k - 1]))
       throw std::invalid_argument("pair resistance: gaps must be positive and increasing");
+  HeldPair pair(a, separating, s);
   PairResistanceEntry e{.hydrodynamic_radius = a,
                         .viscosity = s.viscosity,
-                        .marker_spacing = s.marker_spacing,
-                        .iterations = s.iterations,
-                        .box = static_cast<int>(std::lround(s.box_over_a * a / 2)) * 2,
+                        .scheme = s.scheme,
+                        .box = pair.box(),
                         .separating = separating};
   for (double g : gaps) {
-    e.points.push_back(measure_pair_resistance(a, g, separating, s));
+    e.points.push_back(pair.measure(g));
     if (progress) progress(e.points.back());
   }
   e.box_offset = e.points.back().lambda_measured - e.points.back().lambda_exact;
@@ -112,14 +142,14 @@ void PairResistanceTable::save(const std::string& filename) const {
                         {"lambda_measured", p.lambda_measured},
                         {"lambda_exact", p.lambda_exact},
                         {"steps", p.steps}});
-    j["entries"].push_back({{"hydrodynamic_radius", e.hydrodynamic_radius},
-                            {"viscosity", e.viscosity},
-                            {"marker_spacing", e.marker_spacing},
-                            {"iterations", e.iterations},
-                            {"box", e.box},
-                            {"separating", e.separating},
-                            {"box_offset", e.box_offset},
-                            {"points", points}});
+    nlohmann::json je = {{"hydrodynamic_radius", e.hydrodynamic_radius},
+                         {"viscosity", e.viscosity},
+                         {"box", e.box},
+                         {"separating", e.separating},
+                         {"box_offset", e.box_offset},
+                         {"points", points}};
+    write_scheme(je, e.scheme);
+    j["entries"].push_back(je);
   }
   std::ofstream out(filename);
   if (!out) throw std::runtime_error("cannot write pair-resistance table " + filename);
@@ -151,8 +181,7 @@ PairResistanceTable PairResistanceTable::parse(const std::string& json_text,
       PairResistanceEntry e;
       e.hydrodynamic_radius = je.at("hydrodynamic_radius").get<double>();
       e.viscosity = je.at("viscosity").get<double>();
-      e.marker_spacing = je.at("marker_spacing").get<double>();
-      e.iterations = je.at("iterations").get<int>();
+      e.scheme = scheme_from_entry(je, origin);
       e.box = je.at("box").get<int>();
       e.separating = je.at("separating").get<bool>();
       e.box_offset = je.at("box_offset").get<double>();
@@ -170,9 +199,8 @@ PairResistanceTable PairResistanceTable::parse(const std::string& json_text,
 }
 
 namespace {
-bool same_scheme(const PairResistanceEntry& e, double a, double spacing, int iterations) {
-  return !e.separating && std::abs(e.hydrodynamic_radius - a) <= 1e-6 &&
-         std::abs(e.marker_spacing - spacing) <= 1e-9 && e.iterations == iterations;
+bool same_scheme(const PairResistanceEntry& e, double a, const immersed_boundary::Scheme& scheme) {
+  return !e.separating && std::abs(e.hydrodynamic_radius - a) <= 1e-6 && e.scheme == scheme;
 }
 }  // namespace
 
@@ -180,35 +208,36 @@ void PairResistanceTable::add(const PairResistanceEntry& entry) {
   std::erase_if(entries_, [&](const PairResistanceEntry& e) {
     return e.separating == entry.separating &&
            std::abs(e.hydrodynamic_radius - entry.hydrodynamic_radius) <= 1e-6 &&
-           std::abs(e.viscosity - entry.viscosity) <= 1e-12 &&
-           std::abs(e.marker_spacing - entry.marker_spacing) <= 1e-9 &&
-           e.iterations == entry.iterations;
+           std::abs(e.viscosity - entry.viscosity) <= 1e-12 && e.scheme == entry.scheme;
   });
   entries_.push_back(entry);
 }
 
-bool PairResistanceTable::has(double a, double spacing, int iterations) const {
+bool PairResistanceTable::has(double a, const immersed_boundary::Scheme& scheme) const {
   return std::any_of(entries_.begin(), entries_.end(),
-                     [&](const auto& e) { return same_scheme(e, a, spacing, iterations); });
+                     [&](const auto& e) { return same_scheme(e, a, scheme); });
 }
 
-std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(double a, double nu,
-                                                                          double spacing,
-                                                                          int iterations) const {
+std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
+    double a, double nu, const immersed_boundary::Scheme& scheme) const {
   const PairResistanceEntry *below = nullptr, *above = nullptr;
   for (const auto& e : entries_) {
-    if (!same_scheme(e, a, spacing, iterations)) continue;
+    if (!same_scheme(e, a, scheme)) continue;
     if (e.viscosity <= nu && (!below || e.viscosity > below->viscosity)) below = &e;
     if (e.viscosity >= nu && (!above || e.viscosity < above->viscosity)) above = &e;
   }
   if (!below && !above) {
     std::ostringstream msg;
-    msg << "no close-pair calibration for a = " << a << " dx (marker spacing " << spacing << ", "
-        << iterations << " iterations); calibrated:";
-    for (const auto& e : entries_)
-      if (!e.separating)
-        msg << " a = " << e.hydrodynamic_radius << " (nu = " << e.viscosity << ", spacing "
-            << e.marker_spacing << ", " << e.iterations << " it)";
+    msg << "no close-pair calibration for a = " << a << " dx with " << scheme.describe()
+        << "; calibrated:";
+    std::vector<std::string> seen;
+    for (const auto& e : entries_) {
+      if (e.separating) continue;
+      std::ostringstream one;
+      one << " a = " << e.hydrodynamic_radius << " (" << e.scheme.describe() << ")";
+      if (std::find(seen.begin(), seen.end(), one.str()) == seen.end()) seen.push_back(one.str());
+    }
+    for (const auto& one : seen) msg << one;
     msg << ". Run `flocsim calibrate --close-pairs`, or set lubrication_model to nguyen-ladd.";
     throw std::out_of_range(msg.str());
   }

@@ -18,20 +18,22 @@
 #include <utility>
 #include <vector>
 
+#include "engine/immersed_boundary/scheme.hpp"
+
 namespace flocsim::calibration {
 
 struct PairResistanceSettings {
   double viscosity = 1.0 / 6.0;
-  double marker_spacing = 0.7;
-  int iterations = 2;
+  immersed_boundary::Scheme scheme;
   double box_over_a = 16;   // box 16a x 8a x 8a (rounded to whole cells)
   double reynolds = 0.01;   // 2 a V / nu: creeping flow
   double tolerance = 2e-6;  // steady: relative change of lambda per 200 steps
   long max_steps = 1000000;
 };
 
-// One held pair at gap s (in units of a); returns lambda_measured and the steps
-// taken. Double precision, the shipped hydrodynamic-radius calibration.
+// One held pair at gap s (in units of a), from a liquid at rest; returns
+// lambda_measured and the steps taken. Double precision, the shipped
+// hydrodynamic-radius calibration of the scheme.
 struct PairResistancePoint {
   double gap_over_a = 0;
   double lambda_measured = 0;  // box images included
@@ -48,8 +50,7 @@ std::vector<double> default_pair_gaps();
 struct PairResistanceEntry {
   double hydrodynamic_radius = 0;
   double viscosity = 0;
-  double marker_spacing = 0.7;
-  int iterations = 2;
+  immersed_boundary::Scheme scheme;
   int box = 0;  // length along the line of centres (dx); the cross-section is half
   bool separating = false;
   double box_offset = 0;                    // lambda_measured - lambda_exact at the largest gap
@@ -59,6 +60,9 @@ struct PairResistanceEntry {
   double lattice_share(double gap_over_a) const;
 };
 
+// All gaps in one box: each gap starts from the steady flow of the one before
+// (the spheres moved, the liquid kept), which reaches the same steady state in
+// a fraction of the steps from rest.
 PairResistanceEntry calibrate_pair_resistance(
     double hydrodynamic_radius, const std::vector<double>& gaps, bool separating,
     const PairResistanceSettings& s, void (*progress)(const PairResistancePoint&) = nullptr);
@@ -74,15 +78,15 @@ class PairResistanceTable {
   void add(const PairResistanceEntry& entry);
   const std::vector<PairResistanceEntry>& entries() const { return entries_; }
   // Whether an approaching entry exists for this a and scheme.
-  bool has(double hydrodynamic_radius, double marker_spacing = 0.7, int iterations = 2) const;
+  bool has(double hydrodynamic_radius, const immersed_boundary::Scheme& scheme = {}) const;
   // lambda_IB at the gaps of the calibration, (s/a, lambda_IB) in increasing
   // s/a, for a at nu: between the two approaching entries whose viscosities
   // bracket nu, linear in log(nu) at every gap; outside the calibrated
   // viscosities the nearest entry (no extrapolation). Throws std::out_of_range
   // naming what exists when no entry has this a and scheme.
-  std::vector<std::pair<double, double>> lattice_share(double hydrodynamic_radius, double viscosity,
-                                                       double marker_spacing = 0.7,
-                                                       int iterations = 2) const;
+  std::vector<std::pair<double, double>> lattice_share(
+      double hydrodynamic_radius, double viscosity,
+      const immersed_boundary::Scheme& scheme = {}) const;
   std::string note;
 
  private:

@@ -26,11 +26,37 @@ namespace {
 // effect on F); draft is for quick looks and CI.
 struct Preset {
   double radius_cells, length_over_a, stage1_min, stage1_max, stage2_settle, statistics;
+  immersed_boundary::Scheme ib_scheme;
 };
 Preset preset(const std::string& fidelity) {
-  if (fidelity == "draft") return {4, 16, 5, 20, 10, 20};
-  if (fidelity == "standard") return {6, 32, 20, 100, 50, 100};
-  return {6, 48, 30, 150, 100, 300};  // paper
+  using immersed_boundary::kPaperScheme;
+  if (fidelity == "draft") return {4, 16, 5, 20, 10, 20, kPaperScheme};
+  if (fidelity == "standard") return {6, 32, 20, 100, 50, 100, kPaperScheme};
+  return {6, 48, 30, 150, 100, 300, kPaperScheme};  // paper
+}
+
+// numerics.immersed_boundary: {"marker_spacing", "sweeps", "kernel"}, each
+// defaulting to the preset's value.
+immersed_boundary::Scheme read_ib_scheme(InputReader& numerics,
+                                         const immersed_boundary::Scheme& preset_scheme) {
+  immersed_boundary::Scheme scheme = preset_scheme;
+  if (!numerics.has("immersed_boundary")) return scheme;
+  InputReader ib = numerics.object("immersed_boundary");
+  scheme.marker_spacing =
+      ib.number("marker_spacing", {.above = 0.2, .at_most = 1.5}, preset_scheme.marker_spacing);
+  scheme.sweeps =
+      static_cast<int>(ib.integer("sweeps", {.at_least = 1, .at_most = 20}, preset_scheme.sweeps));
+  scheme.kernel = *immersed_boundary::kernel_from_name(
+      ib.choice("kernel", immersed_boundary::kernel_names(),
+                immersed_boundary::kernel_name(preset_scheme.kernel)));
+  ib.finish();
+  return scheme;
+}
+
+// "{marker_spacing 1, sweeps 1, kernel roma3}"
+std::string scheme_fields(const immersed_boundary::Scheme& s) {
+  return "{marker_spacing " + format_value(s.marker_spacing) + ", sweeps " +
+         std::to_string(s.sweeps) + ", kernel " + immersed_boundary::kernel_name(s.kernel) + "}";
 }
 
 // Sphere centres of a snapshot written by a run (spheres/step_N.h5), checked
@@ -162,6 +188,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     }
   }
   c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
+  c.ib_scheme = read_ib_scheme(num, p.ib_scheme);
   c.input_radius_given = num.has("input_radius");
   if (c.input_radius_given)
     c.input_radius = num.number(
@@ -215,10 +242,21 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   if (c.scene != "granular" && !c.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one
+    const auto& table = calibration::CalibrationTable::shipped();
+    if (table.has(a, immersed_boundary::kPaperScheme) && !table.has(a, c.ib_scheme))
+      throw InputError(
+          "numerics.immersed_boundary = " + scheme_fields(c.ib_scheme) +
+          ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
+          c.ib_scheme.describe() + "); calibrate it with `flocsim calibrate --radius " +
+          format_value(a) + " --viscosity NU --marker-spacing " +
+          format_value(c.ib_scheme.marker_spacing) + " --sweeps " +
+          std::to_string(c.ib_scheme.sweeps) + " --kernel " +
+          immersed_boundary::kernel_name(c.ib_scheme.kernel) +
+          " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
+          "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
     try {
-      const auto& table = calibration::CalibrationTable::shipped();
-      c.input_radius = table.input_radius(a, c.viscosity);
-      c.calibration_viscosity = table.lookup(a, c.viscosity).viscosity;
+      c.input_radius = table.input_radius(a, c.viscosity, c.ib_scheme);
+      c.calibration_viscosity = table.lookup(a, c.viscosity, c.ib_scheme).viscosity;
     } catch (const std::out_of_range& e) {
       throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
                        " Or give numerics.input_radius (the marker radius a_g) yourself.");
@@ -233,7 +271,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   if (c.scene == "suspension" && c.lubrication_model == "calibrated") {
     const auto& pairs = calibration::PairResistanceTable::shipped();
     try {
-      c.lubrication_lattice_share = pairs.lattice_share(a, c.viscosity);
+      c.lubrication_lattice_share = pairs.lattice_share(a, c.viscosity, c.ib_scheme);
     } catch (const std::out_of_range& e) {
       throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
                        format_value(a) + ": " + e.what());
@@ -340,6 +378,11 @@ nlohmann::json SuspensionCase::to_json() const {
   j["L_over_a"] = length_over_a;
   j["L_over_W"] = length_over_width;
   j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
+  if (scene != "granular")
+    j["numerics"]["immersed_boundary"] = {
+        {"marker_spacing", ib_scheme.marker_spacing},
+        {"sweeps", ib_scheme.sweeps},
+        {"kernel", immersed_boundary::kernel_name(ib_scheme.kernel)}};
   if (input_radius_given) j["numerics"]["input_radius"] = input_radius;
   j["protocol"] = {{"stage1_min", stage1_min},
                    {"stage1_max", stage1_max},

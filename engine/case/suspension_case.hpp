@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/immersed_boundary/scheme.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 
 namespace flocsim::cases {
@@ -70,6 +71,9 @@ struct SuspensionCase {
   double radius_cells = 6;  // hydrodynamic radius a / dx
   double viscosity = 0;     // lattice nu (derived when not given)
   double trt_magic = 0.25;
+  // numerics.immersed_boundary: marker spacing, forcing sweeps, kernel; the
+  // preset's default, and only schemes the shipped calibration holds at this a
+  immersed_boundary::Scheme ib_scheme;
   // Marker radius a_g of the immersed boundary, which gives hydrodynamic
   // radius a: numerics.input_radius, or looked up in the shipped calibration
   // table (engine/calibration), interpolated in log(nu) between the calibrated

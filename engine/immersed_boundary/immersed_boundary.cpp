@@ -15,6 +15,7 @@
 #include <immintrin.h>
 #endif
 
+#include "engine/immersed_boundary/direct_forcing.hpp"
 #include "engine/immersed_boundary/kernel.hpp"
 #include "engine/immersed_boundary/sphere_markers.hpp"
 
@@ -25,6 +26,31 @@ namespace {
 int wrap(int i, int n) {
   i %= n;
   return i < 0 ? i + n : i;
+}
+
+// The cells a sphere reads and forces: a box of B^3 cells from its lowest
+// corner `lo` (unwrapped lattice coordinates), of which box row (j, k) uses
+// cells i0 .. i1 (i0 > i1: none), stored as rows[2 (j + B k)], rows[... + 1].
+// The one walk over them: run(j, k, i, x, count, r) for every piece
+// i .. i + count - 1 of box row (j, k) that lies at lattice x .. x + count - 1
+// of lattice row r = y + ny z; pieces never cross the periodic edge in x.
+template <class Run>
+void for_each_box_run(const std::array<int, 3>& lo, const std::int16_t* rows, int B,
+                      const lattice::Extent& e, Run&& run) {
+  for (int k = 0; k < B; ++k) {
+    const long plane = static_cast<long>(e.ny) * wrap(lo[2] + k, e.nz);
+    for (int j = 0; j < B; ++j) {
+      const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
+      if (i0 > i1) continue;
+      const long r = wrap(lo[1] + j, e.ny) + plane;
+      for (int i = i0; i <= i1;) {
+        const int x = wrap(lo[0] + i, e.nx);
+        const int count = std::min(i1 - i + 1, e.nx - x);
+        run(j, k, i, x, count, r);
+        i += count;
+      }
+    }
+  }
 }
 
 // Spheres grouped into blocks, blocks grouped by colour: two blocks of one
@@ -102,47 +128,56 @@ struct Simd {
   }
 };
 
-// The 27-cell stencil of one marker in a sphere's scratch box, shared by
-// interpolation and spreading. Every box cell holds four numbers, so a row of
-// four cells is one 16-number vector; a stencil row is three cells plus a
-// fourth with weight zero (the box rows have one spare cell for it), and each
-// operation is nine whole-row vector steps per marker.
+// The W^3-cell stencil of one marker (W = 3: Roma, W = 2: linear) in a
+// sphere's scratch box, shared by interpolation and spreading. Every box cell
+// holds four numbers, so a row of four cells is one 16-number vector; a
+// stencil row is W cells plus 4 - W with weight zero (the box rows have one
+// spare cell for them), and each operation is W^2 whole-row vector steps.
 //   state: (rho, v) per cell, v = u* + F / (2 rho): the velocity the collision sees;
 //   force: (0, F) per cell, F this sphere's force density.
-// w: the marker's 16 weight slots: x weights wx[a] in slots 0-2, the products
-// wy[b] wz[c] in slot 3 + b + 3 c, slots 12-15 zero.
+// w: the marker's 16 weight slots: x weights wx[a] in slots 0 .. W-1, the
+// products wy[b] wz[c] in slot W + b + W c, the rest zero.
 // base: the marker's stencil corner as an offset in numbers (4 per cell).
-template <class Real>
+template <class Real, int W>
 struct Stencil {
+  static_assert(W == 2 || W == 3, "kernel width 2 or 3");
+  static constexpr int kRows = W * W;
   using V4 = typename Simd<Real>::V4;
   using V16 = typename Simd<Real>::V16;
-  std::size_t offset[9];  // numbers from the corner to stencil row (b, c), index b + 3 c
+  std::size_t offset[kRows];  // numbers from the corner to stencil row (b, c), index b + W c
 
   Stencil(int row_cells, int box) {
-    for (int c = 0; c < 3; ++c)
-      for (int b = 0; b < 3; ++b)
-        offset[b + 3 * c] = 4 * static_cast<std::size_t>(row_cells) * (b + box * c);
+    for (int c = 0; c < W; ++c)
+      for (int b = 0; b < W; ++b)
+        offset[b + W * c] = 4 * static_cast<std::size_t>(row_cells) * (b + box * c);
   }
-  // x weight of each of the 16 numbers of a stencil row (zero for the fourth cell).
+  // x weight of each of the 16 numbers of a stencil row (slot 15 is zero).
   static V16 row_weights(const V16& w) {
-    return __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 15, 15, 15, 15);
+    if constexpr (W == 3)
+      return __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 15, 15, 15, 15);
+    else
+      return __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 15, 15, 15, 15, 15, 15, 15, 15);
   }
 
   // Interpolated (rho, v) at the marker: the x weights multiply the sum of
-  // the nine rows weighted by wy wz.
+  // the W^2 rows weighted by wy wz.
   V4 interpolate(const Real* state, std::size_t base, const V16& w) const {
-    const Real* wyz = reinterpret_cast<const Real*>(&w) + 3;
-    const std::size_t o[9] = {offset[0], offset[1], offset[2], offset[3], offset[4],
-                              offset[5], offset[6], offset[7], offset[8]};
+    const Real* wyz = reinterpret_cast<const Real*>(&w) + W;
+    std::size_t o[kRows];
+    for (int l = 0; l < kRows; ++l) o[l] = offset[l];
     V16 acc[3] = {};  // three independent sums: a shorter dependency chain
 #pragma GCC unroll 9
-    for (int l = 0; l < 9; ++l)
+    for (int l = 0; l < kRows; ++l)
       acc[l % 3] += wyz[l] * Simd<Real>::template load<V16>(state + base + o[l]);
     V16 sum = (acc[0] + acc[1] + acc[2]) * row_weights(w);
     const V4 a = __builtin_shufflevector(sum, sum, 0, 1, 2, 3);
     const V4 b = __builtin_shufflevector(sum, sum, 4, 5, 6, 7);
-    const V4 c = __builtin_shufflevector(sum, sum, 8, 9, 10, 11);
-    return a + b + c;
+    if constexpr (W == 3) {
+      const V4 c = __builtin_shufflevector(sum, sum, 8, 9, 10, 11);
+      return a + b + c;
+    } else {
+      return a + b;
+    }
   }
 
   // Adds (0, F_m dV) spread with the kernel to force; s points to those 4
@@ -151,12 +186,12 @@ struct Stencil {
     const V16 s4 = Simd<Real>::template load<V16>(s);
     const V16 ws = row_weights(w) *
                    __builtin_shufflevector(s4, s4, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3);
-    const Real* wyz = reinterpret_cast<const Real*>(&w) + 3;
-    const std::size_t o[9] = {offset[0], offset[1], offset[2], offset[3], offset[4],
-                              offset[5], offset[6], offset[7], offset[8]};
+    const Real* wyz = reinterpret_cast<const Real*>(&w) + W;
+    std::size_t o[kRows];
+    for (int l = 0; l < kRows; ++l) o[l] = offset[l];
     Real* f = force + base;
 #pragma GCC unroll 9
-    for (int l = 0; l < 9; ++l)
+    for (int l = 0; l < kRows; ++l)
       Simd<Real>::store(f + o[l], Simd<Real>::template load<V16>(f + o[l]) + ws * wyz[l]);
   }
 };
@@ -185,39 +220,40 @@ struct ImmersedBoundary<Real>::Workspace {
         frac(3 * static_cast<std::size_t>(markers)),
         root(3 * static_cast<std::size_t>(markers)),
         packed(12 * static_cast<std::size_t>(markers)) {}
-  int row_cells;  // box + 1: room for the fourth cell of a stencil row at the far end
+  int row_cells;  // box + 1: room for the spare cells of a stencil row at the far end
   std::size_t cells;
-  // u* = (rho, u*), state = (rho, v) (see Stencil), half_inv: 1 / (2 rho) four
-  // times, force = (0, F): 4 numbers per cell.
-  std::vector<Real> ustar, state, half_inv, force;  // 4 numbers per cell
-  std::vector<int> global[3];                       // wrapped lattice coordinate of each box row
+  // u* = (rho, u*); state = (rho, v) (see Stencil), from the second sweep on;
+  // half_inv: 1 / (2 rho) four times; force = (0, F): 4 numbers per cell.
+  std::vector<Real> ustar, state, half_inv, force;
   std::vector<std::size_t> base;                    // stencil corner of each marker (numbers)
   std::vector<V16> weights;                         // kernel weights of each marker
   std::vector<V4> target, marker_force, increment;  // (0, vector) per marker
-  std::vector<int> first;          // per direction and marker: first stencil cell in the box
-  std::vector<double> frac, root;  // per direction and marker: X - round(X), the root q
-  std::vector<Real> packed;        // per weight slot and marker, before packing
+  std::vector<int> first;  // per direction and marker: first stencil cell in the box
+  std::vector<double> frac,
+      root;                  // per direction and marker: offset from the kernel's node, Roma's root
+  std::vector<Real> packed;  // per weight slot and marker, before packing
   std::vector<const Real*> lines;  // cache lines of the next sphere
   int fetched = -1;                // the sphere whose lines were fetched
 };
 
 template <class Real>
 ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings) : settings_(settings) {
+  const Scheme& scheme = settings.scheme;
   if (!(settings.input_radius >= 1.0))
     throw std::invalid_argument(
         "immersed boundary: input_radius = " + std::to_string(settings.input_radius) +
-        ": must be at least 1 dx (the kernel is 3 dx wide)");
-  if (!(settings.marker_spacing > 0.2 && settings.marker_spacing <= 1.0))
+        ": must be at least 1 dx (the kernel is up to 3 dx wide)");
+  if (!(scheme.marker_spacing > 0.2 && scheme.marker_spacing <= 1.5))
     throw std::invalid_argument(
-        "immersed boundary: marker_spacing = " + std::to_string(settings.marker_spacing) +
-        ": must be in (0.2, 1] dx");
-  if (settings.iterations < 1 || settings.iterations > 20)
-    throw std::invalid_argument("immersed boundary: iterations = " +
-                                std::to_string(settings.iterations) + ": must be in [1, 20]");
+        "immersed boundary: marker_spacing = " + std::to_string(scheme.marker_spacing) +
+        ": must be in (0.2, 1.5] dx");
+  if (scheme.sweeps < 1 || scheme.sweeps > 20)
+    throw std::invalid_argument("immersed boundary: sweeps = " + std::to_string(scheme.sweeps) +
+                                ": must be in [1, 20]");
   if (!(settings.input_radius <= 10000.0))
     throw std::invalid_argument("immersed boundary: input_radius = " +
                                 std::to_string(settings.input_radius) + ": must be <= 10000 dx");
-  const int n = marker_count(settings.input_radius, settings.marker_spacing);
+  const int n = marker_count(settings.input_radius, scheme.marker_spacing);
   directions_ = fibonacci_sphere(n);
   for (const Vec3& u : directions_)
     for (int d = 0; d < 3; ++d) offsets_.push_back(settings.input_radius * u[d]);
@@ -229,47 +265,50 @@ template <class Real>
 ImmersedBoundary<Real>::~ImmersedBoundary() = default;
 
 template <class Real>
-void ImmersedBoundary<Real>::zero_boxes(lattice::FluidLattice<Real>& fluid) {
+void ImmersedBoundary<Real>::zero_boxes(const lattice::ForceFieldView<Real>& field) {
   if (written_.empty()) return;
-  const lattice::Extent e = fluid.extent();
+  const lattice::Extent& e = field.extent;
   const auto colours = make_colours(written_, box_, e);
   const int B = box_;
-  Real* field[3] = {fluid.force_field(0), fluid.force_field(1), fluid.force_field(2)};
 #pragma omp parallel
   for (const auto& blocks : colours) {
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t b = 0; b < blocks.size(); ++b)
-      for (int s : blocks[b]) {
-        const auto& o = written_[static_cast<std::size_t>(s)];
-        const std::int16_t* rows = &written_rows_[2 * static_cast<std::size_t>(s) * B * B];
-        for (int k = 0; k < B; ++k)
-          for (int j = 0; j < B; ++j) {
-            const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-            if (i0 > i1) continue;
-            const long row = fluid.cell_index(0, wrap(o[1] + j, e.ny), wrap(o[2] + k, e.nz));
-            for (int i = i0; i <= i1;) {
-              const int gx = wrap(o[0] + i, e.nx);
-              const int count = std::min(i1 - i + 1, e.nx - gx);
-              for (int d = 0; d < 3; ++d) std::fill_n(field[d] + row + gx, count, Real(0));
-              i += count;
-            }
-          }
-      }
+      for (int s : blocks[b])
+        for_each_box_run(written_[static_cast<std::size_t>(s)],
+                         &written_rows_[2 * static_cast<std::size_t>(s) * B * B], B, e,
+                         [&](int, int, int, int x, int count, long r) {
+                           for (int d = 0; d < 3; ++d)
+                             std::fill_n(field.row(d, r) + x, count, Real(0));
+                         });
   }
   written_.clear();
 }
 
 template <class Real>
-void ImmersedBoundary<Real>::remove(lattice::FluidLattice<Real>& fluid) {
-  if (fluid.has_force_field()) zero_boxes(fluid);
+void ImmersedBoundary<Real>::remove(lattice::ForcedLiquid<Real>& liquid) {
+  const auto set = liquid.force_field_if_set();
+  if (!set.empty()) zero_boxes(liquid.force_field());
 }
 
 template <class Real>
-void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
+void ImmersedBoundary<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
                                    const spheres::SphereSet& spheres) {
+  if (kernel_width(settings_.scheme.kernel) == 3)
+    apply_with_kernel<3>(liquid, spheres);
+  else
+    apply_with_kernel<2>(liquid, spheres);
+}
+
+template <class Real>
+template <int W>
+void ImmersedBoundary<Real>::apply_with_kernel(lattice::ForcedLiquid<Real>& liquid,
+                                               const spheres::SphereSet& spheres) {
   using V4 = typename Simd<Real>::V4;
   using V4d = typename Simd<double>::V4;
-  const lattice::Extent e = fluid.extent();
+  // A stencil cell lies within W/2 of its marker in each direction.
+  constexpr double half_width = 0.5 * W;
+  const lattice::Extent e = liquid.extent();
   const double ag = settings_.input_radius;
   const int length[3] = {e.nx, e.ny, e.nz};
   for (int d = 0; d < 3; ++d)
@@ -278,7 +317,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
           "immersed boundary: box length " + std::to_string(length[d]) +
           " must exceed 2 a_g + 3 = " + std::to_string(2.0 * ag + 3.0) +
           " (a sphere's kernel cells must not meet its own periodic image)");
-  if (!fluid.has_force_field()) fluid.enable_force_field();
+  const lattice::ForceFieldView<Real> field = liquid.force_field();
 
   const std::size_t n = spheres.size();
   const int B = box_;
@@ -293,73 +332,67 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     for (int d = 0; d < 3; ++d)
       origins_[s][d] = static_cast<int>(std::floor(spheres.position[s][d] - ag)) - 2;
   rows_.resize(2 * n * static_cast<std::size_t>(B) * B);
-  Real* field[3] = {fluid.force_field(0), fluid.force_field(1), fluid.force_field(2)};
+  auto rows_of = [&](std::size_t s) { return &rows_[2 * s * B * B]; };
 
   // The lattice rows are cut in 16-cell chunks; need_ marks the chunks with
   // cells that this apply() reads, held_ those holding force from the last one.
   const int chunks = (e.nx + 15) / 16;
   const int words = (chunks + 63) / 64;
-  const std::size_t lattice_rows = static_cast<std::size_t>(e.ny) * e.nz;
+  const std::size_t lattice_rows = static_cast<std::size_t>(e.rows());
   const bool zero_in_pass = !written_.empty() && held_.size() == lattice_rows * words;
-  if (!zero_in_pass) zero_boxes(fluid);
+  if (!zero_in_pass) zero_boxes(field);
   if (need_.size() != lattice_rows * words) need_.assign(lattice_rows * words, 0);
   ustar_.resize(4 * static_cast<std::size_t>(e.cells()));
 
-  // The cells of every marker stencil: a stencil cell is within 1.5 of its
-  // marker in each direction, so it lies in the cube of half-width 1.5 around
-  // some point of the sphere |X - centre| = a_g. Per box row: the cells whose
-  // cube meets the ball of radius a_g (holes filled; this includes the inside,
-  // |r| < a_g + 1/2, that the momentum sums need).
+  // The cells of every marker stencil: a stencil cell is within W/2 of its
+  // marker in each direction, so it lies in the cube of that half-width
+  // around some point of the sphere |X - centre| = a_g. Per box row: the cells
+  // whose cube meets the ball of radius a_g (holes filled; this includes the
+  // inside, |r| < a_g + 1/2, that the momentum sums need).
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::size_t s = 0; s < n; ++s) {
     const Vec3 centre = spheres.position[s];
     const auto& lo = origins_[s];
-    std::int16_t* rows = &rows_[2 * s * B * B];
+    std::int16_t* rows = rows_of(s);
     for (int k = 0; k < B; ++k) {
-      const double ez = std::max(0.0, std::abs(lo[2] + k - centre[2]) - 1.5);
-      const int gz = wrap(lo[2] + k, e.nz);
+      const double ez = std::max(0.0, std::abs(lo[2] + k - centre[2]) - half_width);
       for (int j = 0; j < B; ++j) {
-        const double ey = std::max(0.0, std::abs(lo[1] + j - centre[1]) - 1.5);
+        const double ey = std::max(0.0, std::abs(lo[1] + j - centre[1]) - half_width);
         const double left = ag * ag - ey * ey - ez * ez;
         int i0 = 1, i1 = 0;
         if (left >= 0) {
-          const double half = 1.5 + std::sqrt(left) + 1e-9;
+          const double half = half_width + std::sqrt(left) + 1e-9;
           i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
           i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
         }
         rows[2 * (j + B * k)] = static_cast<std::int16_t>(i0);
         rows[2 * (j + B * k) + 1] = static_cast<std::int16_t>(i1);
-        if (i0 > i1) continue;
-        std::uint64_t* word =
-            &need_[(static_cast<std::size_t>(wrap(lo[1] + j, e.ny)) + e.ny * gz) * words];
-        for (int i = i0; i <= i1;) {
-          const int gx = wrap(lo[0] + i, e.nx);
-          const int count = std::min(i1 - i + 1, e.nx - gx);
-          for (int c = gx / 16; c <= (gx + count - 1) / 16; ++c)
-            std::atomic_ref<std::uint64_t>(word[c / 64])
-                .fetch_or(std::uint64_t(1) << (c % 64), std::memory_order_relaxed);
-          i += count;
-        }
       }
     }
+    for_each_box_run(lo, rows, B, e, [&](int, int, int, int x, int count, long r) {
+      std::uint64_t* word = &need_[static_cast<std::size_t>(r) * words];
+      for (int c = x / 16; c <= (x + count - 1) / 16; ++c)
+        std::atomic_ref<std::uint64_t>(word[c / 64])
+            .fetch_or(std::uint64_t(1) << (c % 64), std::memory_order_relaxed);
+    });
   }
   // The pass over the lattice rows, in memory order: zero the force field on
   // the chunks of the last apply() and compute u* on the chunks needed now
   // (runs of chunks at once), so that the streams are read nearly in order.
   auto pass_row = [&](std::size_t r) {
     const int y = static_cast<int>(r % e.ny), z = static_cast<int>(r / e.ny);
-    const long row = fluid.cell_index(0, y, z);
     if (zero_in_pass) {
       std::uint64_t* held = &held_[r * words];
       for (int c = 0; c < chunks; ++c)
         if (held[c / 64] >> (c % 64) & 1) {
           const int x0 = 16 * c, count = std::min(16, e.nx - x0);
-          for (int d = 0; d < 3; ++d) std::fill_n(field[d] + row + x0, count, Real(0));
+          for (int d = 0; d < 3; ++d)
+            std::fill_n(field.row(d, static_cast<long>(r)) + x0, count, Real(0));
         }
       std::fill_n(held, words, std::uint64_t(0));
     }
     const std::uint64_t* need = &need_[r * words];
-    Real* out = &ustar_[4 * static_cast<std::size_t>(row)];
+    Real* out = &ustar_[4 * static_cast<std::size_t>(e.nx) * r];
     for (int c = 0; c < chunks;) {
       if (!(need[c / 64] >> (c % 64) & 1)) {
         ++c;
@@ -368,7 +401,7 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
       int c1 = c + 1;
       while (c1 < chunks && (need[c1 / 64] >> (c1 % 64) & 1)) ++c1;
       const int x0 = 16 * c, x1 = std::min(e.nx, 16 * c1);
-      fluid.macroscopic_row_without_force_field(x0, x1 - x0, y, z, out + 4 * x0);
+      liquid.macroscopic_row_without_force_field(x0, x1 - x0, y, z, out + 4 * x0);
       c = c1;
     }
   };
@@ -382,36 +415,26 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
 
   std::vector<double> slip_sq(settings_.measure_slip ? n : 0),
       slip_max(settings_.measure_slip ? n : 0);
-  const int iterations = settings_.iterations;
+  const int sweeps = settings_.scheme.sweeps;
   const bool measure = settings_.measure_slip;
-  const Stencil<Real> stencil(B + 1, B);
+  const Stencil<Real, W> stencil(B + 1, B);
   const Real dVr = static_cast<Real>(dV);
-  const V4 vector_part = {0, 1, 1, 1};
 
   // Calls fetch(address) for each cache line of ustar_ that sphere s reads
   // and of the force field that it adds to.
   auto sphere_lines = [&](int s, auto&& fetch) {
     constexpr int step = 64 / static_cast<int>(sizeof(Real));
-    const auto& lo = origins_[static_cast<std::size_t>(s)];
-    const std::int16_t* rows = &rows_[2 * static_cast<std::size_t>(s) * B * B];
-    for (int k = 0; k < B; ++k)
-      for (int j = 0; j < B; ++j) {
-        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-        if (i0 > i1) continue;
-        const long grow = fluid.cell_index(0, wrap(lo[1] + j, e.ny), wrap(lo[2] + k, e.nz));
-        for (int i = i0; i <= i1;) {
-          const int gx = wrap(lo[0] + i, e.nx);
-          const int count = std::min(i1 - i + 1, e.nx - gx);
-          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
-          for (int q = 0; q < 4 * count; q += step) fetch(from + q);
-          fetch(from + 4 * count - 1);
-          for (int d = 0; d < 3; ++d) {
-            for (int q = 0; q < count; q += step) fetch(field[d] + grow + gx + q);
-            fetch(field[d] + grow + gx + count - 1);
-          }
-          i += count;
-        }
-      }
+    for_each_box_run(origins_[static_cast<std::size_t>(s)], rows_of(static_cast<std::size_t>(s)), B,
+                     e, [&](int, int, int, int x, int count, long r) {
+                       const Real* from = &ustar_[4 * (static_cast<std::size_t>(e.nx) * r + x)];
+                       for (int q = 0; q < 4 * count; q += step) fetch(from + q);
+                       fetch(from + 4 * count - 1);
+                       for (int d = 0; d < 3; ++d) {
+                         const Real* f = field.row(d, r) + x;
+                         for (int q = 0; q < count; q += step) fetch(f + q);
+                         fetch(f + count - 1);
+                       }
+                     });
   };
 
   auto process = [&](Workspace& ws, int s, int next) {
@@ -419,13 +442,8 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     const Vec3 up = spheres.velocity[static_cast<std::size_t>(s)];
     const Vec3 omega = spheres.angular_velocity[static_cast<std::size_t>(s)];
     const auto& lo = origins_[static_cast<std::size_t>(s)];
-    const std::int16_t* rows = &rows_[2 * static_cast<std::size_t>(s) * B * B];
+    const std::int16_t* rows = rows_of(static_cast<std::size_t>(s));
     const int R = ws.row_cells;
-    for (int d = 0; d < 3; ++d) {
-      ws.global[d].resize(static_cast<std::size_t>(B));
-      for (int i = 0; i < B; ++i)
-        ws.global[d][static_cast<std::size_t>(i)] = wrap(lo[d] + i, length[d]);
-    }
     // The lines of this sphere were fetched during the previous sphere's
     // sweeps, or are fetched now while the stencils are computed; the next
     // sphere's are fetched during this one's sweeps.
@@ -435,13 +453,13 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     ws.fetched = next;
     std::size_t line = 0;
     const std::size_t lines_per_marker =
-        ws.lines.size() / static_cast<std::size_t>(markers * iterations) + 1;
-    // Stencils (Roma weights, one square root per direction) and targets, in
-    // vector loops over the markers (arrays per direction), then packed.
+        ws.lines.size() / static_cast<std::size_t>(markers * sweeps) + 1;
+    // Stencils (kernel weights) and targets, in vector loops over the markers
+    // (arrays per direction), then packed.
     {
       const int M = markers;
       const double* r = offsets_.data();
-      double* frac = ws.frac.data();  // X - round(X)
+      double* frac = ws.frac.data();
       double* q = ws.root.data();
       int* first = ws.first.data();
       const double c[3] = {centre[0], centre[1], centre[2]};
@@ -449,84 +467,63 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
 #pragma omp simd
         for (int m = 0; m < M; ++m) {
           const double X = c[d] + r[3 * m + d];
-          const double near = std::nearbyint(X);
-          first[d * M + m] = static_cast<int>(near) - 1 - lo[d];
-          const double f = X - near;
-          frac[d * M + m] = f;
-          q[d * M + m] = 1.0 - 3.0 * f * f;
+          if constexpr (W == 3) {  // cells round(X) - 1 .. round(X) + 1
+            const double near = std::nearbyint(X);
+            first[d * M + m] = static_cast<int>(near) - 1 - lo[d];
+            const double f = X - near;
+            frac[d * M + m] = f;
+            q[d * M + m] = 1.0 - 3.0 * f * f;
+          } else {  // cells floor(X), floor(X) + 1
+            const double below = std::floor(X);
+            first[d * M + m] = static_cast<int>(below) - lo[d];
+            frac[d * M + m] = X - below;
+          }
         }
       }
-      sqrt_in_place(q, 3 * M);
-      Real* wt = ws.packed.data();  // 12 weights per marker, in slot order
+      if constexpr (W == 3) sqrt_in_place(q, 3 * M);
+      Real* wt = ws.packed.data();  // W + W^2 weights per marker, in slot order
 #pragma omp simd
       for (int m = 0; m < M; ++m) {
-        double w[3][3];
+        double w[3][W];
         for (int d = 0; d < 3; ++d) {
-          roma_weights_from_root(frac[d * M + m], q[d * M + m], w[d]);
+          if constexpr (W == 3)
+            roma_weights_from_root(frac[d * M + m], q[d * M + m], w[d]);
+          else
+            linear_weights(frac[d * M + m], w[d]);
         }
-        for (int a = 0; a < 3; ++a) wt[a * M + m] = static_cast<Real>(w[0][a]);
-        for (int cc = 0; cc < 3; ++cc)
-          for (int b = 0; b < 3; ++b)
-            wt[(3 + b + 3 * cc) * M + m] = static_cast<Real>(w[1][b] * w[2][cc]);
+        for (int a = 0; a < W; ++a) wt[a * M + m] = static_cast<Real>(w[0][a]);
+        for (int cc = 0; cc < W; ++cc)
+          for (int b = 0; b < W; ++b)
+            wt[(W + b + W * cc) * M + m] = static_cast<Real>(w[1][b] * w[2][cc]);
       }
-      const double u0 = up[0], u1 = up[1], u2 = up[2];
-      const double o0 = omega[0], o1 = omega[1], o2 = omega[2];
       for (int m = 0; m < M; ++m) {
         const std::size_t k = static_cast<std::size_t>(m);
-        Real* wm = reinterpret_cast<Real*>(&ws.weights[k]);  // slots 12-15 stay zero
-        for (int l = 0; l < 12; ++l) wm[l] = wt[l * M + m];
+        Real* wm = reinterpret_cast<Real*>(&ws.weights[k]);  // the other slots stay zero
+        for (int l = 0; l < W + W * W; ++l) wm[l] = wt[l * M + m];
         ws.base[k] =
             4 * static_cast<std::size_t>(first[m] + R * (first[M + m] + B * first[2 * M + m]));
-        const double* rm = &r[3 * m];
-        ws.target[k] = V4{0, static_cast<Real>(u0 + o1 * rm[2] - o2 * rm[1]),
-                          static_cast<Real>(u1 + o2 * rm[0] - o0 * rm[2]),
-                          static_cast<Real>(u2 + o0 * rm[1] - o1 * rm[0])};
+        const Vec3 U = surface_velocity(up, omega, Vec3(r[3 * m], r[3 * m + 1], r[3 * m + 2]));
+        ws.target[k] =
+            V4{0, static_cast<Real>(U[0]), static_cast<Real>(U[1]), static_cast<Real>(U[2])};
         ws.marker_force[k] = V4{};
       }
     }
     // u* and 1/(2 rho) of the sphere's cells, from the pass.
-    for (int k = 0; k < B; ++k)
-      for (int j = 0; j < B; ++j) {
-        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-        if (i0 > i1) continue;
-        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
-                                           ws.global[2][static_cast<std::size_t>(k)]);
-        const std::size_t row = static_cast<std::size_t>(R) * (j + B * k);
-        for (int i = i0; i <= i1;) {  // pieces that do not cross the periodic edge in x
-          const int gx = ws.global[0][static_cast<std::size_t>(i)];
-          const int count = std::min(i1 - i + 1, length[0] - gx);
-          const Real* from = &ustar_[4 * static_cast<std::size_t>(grow + gx)];
-          Real* to = &ws.ustar[4 * (row + i)];
-          Real* v = &ws.state[4 * (row + i)];
-          for (int q = 0; q < 4 * count; ++q) to[q] = v[q] = from[q];
-          i += count;
-        }
-        const Real* __restrict st = &ws.state[4 * row];
-        Real* __restrict h = &ws.half_inv[4 * row];
+    for_each_box_run(lo, rows, B, e, [&](int j, int k, int i, int x, int count, long r) {
+      const std::size_t box = static_cast<std::size_t>(R) * (j + B * k) + i;
+      const Real* __restrict from = &ustar_[4 * (static_cast<std::size_t>(e.nx) * r + x)];
+      Real* __restrict to = &ws.ustar[4 * box];
+      Real* __restrict h = &ws.half_inv[4 * box];
+      for (int c = 0; c < 4 * count; ++c) to[c] = from[c];
 #pragma omp simd
-        for (int i = i0; i <= i1; ++i) {
-          const Real v = Real(0.5) / st[4 * i];
-          h[4 * i] = h[4 * i + 1] = h[4 * i + 2] = h[4 * i + 3] = v;
-        }
+      for (int c = 0; c < count; ++c) {
+        const Real v = Real(0.5) / to[4 * c];
+        h[4 * c] = h[4 * c + 1] = h[4 * c + 2] = h[4 * c + 3] = v;
       }
-    // Multi-direct forcing: interpolate at all markers, then spread all (Jacobi).
-    Real* const state = ws.state.data();
-    for (int it = 0; it < iterations; ++it) {
-      for (int m = 0; m < markers; ++m) {
-        for (std::size_t q = 0; q < lines_per_marker && line < ws.lines.size(); ++q)
-          __builtin_prefetch(ws.lines[line++]);
-        const std::size_t k = static_cast<std::size_t>(m);
-        const V4 u = stencil.interpolate(state, ws.base[k], ws.weights[k]);
-        const V4 dF = (Real(2) * u[0]) * (ws.target[k] - u) * vector_part;
-        ws.marker_force[k] += dF;
-        ws.increment[k] = dF * dVr;
-      }
-      for (int m = 0; m < markers; ++m) {
-        const std::size_t k = static_cast<std::size_t>(m);
-        stencil.spread(ws.force.data(), ws.base[k], ws.weights[k],
-                       reinterpret_cast<const Real*>(&ws.increment[k]));
-      }
-      // v = u* + F / (2 rho) on the sphere's cells.
+    });
+    // v = u* + F / (2 rho) on the sphere's cells: what the next sweep (or
+    // the slip measurement) interpolates.
+    auto update_state = [&] {
       for (int row = 0; row < B * B; ++row) {
         const int i0 = rows[2 * row], i1 = rows[2 * row + 1];
         if (i0 > i1) continue;
@@ -539,8 +536,32 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
 #pragma omp simd
         for (std::size_t q = a; q < b; ++q) v[q] = us[q] + h[q] * f[q];
       }
+    };
+    // Multi-direct forcing: interpolate at all markers, then spread all
+    // (Jacobi). The first sweep sees u* itself (no force yet).
+    const Real* state = ws.ustar.data();
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      for (int m = 0; m < markers; ++m) {
+        for (std::size_t q = 0; q < lines_per_marker && line < ws.lines.size(); ++q)
+          __builtin_prefetch(ws.lines[line++]);
+        const std::size_t k = static_cast<std::size_t>(m);
+        const V4 dF =
+            forcing_increment(stencil.interpolate(state, ws.base[k], ws.weights[k]), ws.target[k]);
+        ws.marker_force[k] += dF;
+        ws.increment[k] = dF * dVr;
+      }
+      for (int m = 0; m < markers; ++m) {
+        const std::size_t k = static_cast<std::size_t>(m);
+        stencil.spread(ws.force.data(), ws.base[k], ws.weights[k],
+                       reinterpret_cast<const Real*>(&ws.increment[k]));
+      }
+      if (sweep + 1 < sweeps || measure) {
+        update_state();
+        state = ws.state.data();
+      }
     }
     if (measure) {
+      const V4 vector_part = {0, 1, 1, 1};
       double sq = 0, mx = 0;
       for (int m = 0; m < markers; ++m) {
         const std::size_t k = static_cast<std::size_t>(m);
@@ -564,12 +585,10 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     }
     force_[static_cast<std::size_t>(s)] = F;
     torque_[static_cast<std::size_t>(s)] = T;
-    // Momentum of the liquid inside, rho v = rho u* + F/2 (the collision's),
-    // weighted by w = min(1, a_g + 1/2 - |r|).
+    // Momentum of the liquid inside, rho v = rho (u* + F/(2 rho)) (the
+    // collision's), weighted by inside_weight().
     double P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     const double reach = ag + 0.5;
-    // Cells with |r|^2 <= inner2 have reach - |r| >= 1 (margin for round-off
-    // of the square: such cells get w = 1 from the formula too).
     const double inner2 = (ag - 0.5) * (ag - 0.5) * (1.0 - 1e-12);
     for (int k = 0; k < B; ++k) {
       const double rz = lo[2] + k - centre[2];
@@ -584,13 +603,18 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
         if (i0 > i1) continue;
         // Per cell j = w rho v (lane 0 unused); over the row sum j and rx j.
         V4d sum = {}, moment = {};
-        const Real* st = &ws.state[4 * static_cast<std::size_t>(R) * (j + B * k)];
+        const std::size_t row = 4 * static_cast<std::size_t>(R) * (j + B * k);
+        const Real* us = &ws.ustar[row];
+        const Real* h = &ws.half_inv[row];
+        const Real* f = &ws.force[row];
         for (int i = i0; i <= i1; ++i) {
           const double rx = lo[0] + i - centre[0];
-          const double r2 = rx * rx + ry * ry + rz * rz;  // w = 1 within a_g - 1/2: no sqrt
-          const double w = r2 <= inner2 ? 1.0 : std::min(1.0, reach - std::sqrt(r2));
+          const double w = inside_weight(rx * rx + ry * ry + rz * rz, reach, inner2);
           if (w <= 0) continue;
-          const V4d c = __builtin_convertvector(Simd<Real>::template load<V4>(st + 4 * i), V4d);
+          const V4 v =
+              Simd<Real>::template load<V4>(us + 4 * i) +
+              Simd<Real>::template load<V4>(h + 4 * i) * Simd<Real>::template load<V4>(f + 4 * i);
+          const V4d c = __builtin_convertvector(v, V4d);
           const V4d jc = (w * c[0]) * c;
           sum += jc;
           moment += rx * jc;
@@ -606,29 +630,19 @@ void ImmersedBoundary<Real>::apply(lattice::FluidLattice<Real>& fluid,
     angular[static_cast<std::size_t>(s)] = Vec3(L[0], L[1], L[2]);
     // Add this sphere's force to the lattice field, row by row, and clear the
     // scratch force (nonzero only on the rows' cells).
-    for (int k = 0; k < B; ++k)
-      for (int j = 0; j < B; ++j) {
-        const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-        if (i0 > i1) continue;
-        const long grow = fluid.cell_index(0, ws.global[1][static_cast<std::size_t>(j)],
-                                           ws.global[2][static_cast<std::size_t>(k)]);
-        Real* __restrict f = &ws.force[4 * static_cast<std::size_t>(R) * (j + B * k)];
-        for (int i = i0; i <= i1;) {
-          const int gx = ws.global[0][static_cast<std::size_t>(i)];
-          const int count = std::min(i1 - i + 1, length[0] - gx);
-          Real* __restrict gxp = field[0] + grow + gx - i;
-          Real* __restrict gyp = field[1] + grow + gx - i;
-          Real* __restrict gzp = field[2] + grow + gx - i;
+    for_each_box_run(lo, rows, B, e, [&](int j, int k, int i, int x, int count, long r) {
+      Real* __restrict f = &ws.force[4 * (static_cast<std::size_t>(R) * (j + B * k) + i)];
+      Real* __restrict gx = field.row(0, r) + x;
+      Real* __restrict gy = field.row(1, r) + x;
+      Real* __restrict gz = field.row(2, r) + x;
 #pragma omp simd
-          for (int c = i; c < i + count; ++c) {
-            gxp[c] += f[4 * c + 1];
-            gyp[c] += f[4 * c + 2];
-            gzp[c] += f[4 * c + 3];
-          }
-          i += count;
-        }
-        for (int q = 4 * i0; q < 4 * (i1 + 1); ++q) f[q] = Real(0);
+      for (int c = 0; c < count; ++c) {
+        gx[c] += f[4 * c + 1];
+        gy[c] += f[4 * c + 2];
+        gz[c] += f[4 * c + 3];
       }
+      for (int q = 0; q < 4 * count; ++q) f[q] = Real(0);
+    });
   };
 
   // Blocks of one colour in parallel, handed out one at a time; a thread

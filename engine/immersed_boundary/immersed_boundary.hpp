@@ -1,7 +1,13 @@
 #pragma once
 // No-slip on the sphere surfaces by the immersed-boundary method with
 // multi-direct forcing (Uhlmann 2005; Breugem 2012), coupled to the
-// lattice-Boltzmann liquid through its per-cell force field.
+// lattice-Boltzmann liquid through its per-cell force field (the seam of
+// engine/lattice/forced_liquid.hpp: rows of the velocity without that force,
+// and a view of the force field; nothing else of the lattice).
+//
+// Options (scheme.hpp): the marker spacing, the number of forcing sweeps and
+// the kernel (Roma's 3-point or the 2-point linear hat). The paper's method is
+// 0.7 dx, two sweeps, Roma.
 //
 // Each sphere carries n markers on the sphere of *input* radius a_g (the
 // geometric radius where the no-slip condition is imposed; the calibrated
@@ -12,8 +18,8 @@
 //      any immersed-boundary force: (sum_i c_i f_i + F_body/2) / rho. The
 //      lattice's own macroscopic() adds half of the stored force field, which
 //      would make direct forcing chase its own previous force;
-//   3. for `iterations` sweeps (Jacobi): interpolates u* + F/(2 rho) to every
-//      marker with the Roma 3-point kernel (kernel.hpp), and adds
+//   3. for `sweeps` sweeps (Jacobi): interpolates u* + F/(2 rho) to every
+//      marker with the kernel (kernel.hpp), and adds
 //      dF_m = 2 rho (U_surface - U_m) to the marker force, U_surface =
 //      u_p + omega x r. The factor 2: the lattice velocity carries half of the
 //      force applied in a step (Guo forcing), so a force density F changes the
@@ -35,9 +41,9 @@
 // rigid body, which keeps the explicit coupling stable with multi-direct
 // forcing (the rigid-body approximation made the rotation unstable here).
 //
-// Iterations are done per sphere on a private box of cells around it: forces
+// Sweeps are done per sphere on a private box of cells around it: forces
 // of a neighbouring sphere whose kernel cells overlap (gaps below about 3 dx)
-// are added to the lattice but not seen during this sphere's iterations. The
+// are added to the lattice but not seen during this sphere's sweeps. The
 // lubrication model takes over at those gaps (s0 = 0.2 a).
 //
 // Parallel work: spheres are grouped in blocks of the box (blocks wider than a
@@ -45,12 +51,18 @@
 // coordinates; blocks of one colour never write to the same cell, so threads
 // take whole blocks of one colour at a time and write the force field without
 // atomics.
+//
+// The per-marker physics (kernel weights, the forcing increment, the surface
+// velocity, the inside weight) are plain functions in kernel.hpp and
+// direct_forcing.hpp; immersed_boundary.cpp holds only the scheduling around
+// them (cell boxes, colours, chunk masks, prefetching, vector layout).
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/lattice/forced_liquid.hpp"
 #include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::immersed_boundary {
@@ -58,10 +70,9 @@ namespace flocsim::immersed_boundary {
 using spheres::Vec3;
 
 struct ImmersedBoundarySettings {
-  double input_radius = 5.6;    // a_g: markers sit on this sphere (lattice units)
-  double marker_spacing = 0.7;  // mean distance between markers (dx)
-  int iterations = 2;           // direct-forcing sweeps per time step
-  bool measure_slip = false;    // one more interpolation per step, for diagnostics
+  double input_radius = 5.6;  // a_g: markers sit on this sphere (lattice units)
+  Scheme scheme;              // marker spacing, forcing sweeps, kernel
+  bool measure_slip = false;  // one more interpolation per step, for diagnostics
 };
 
 template <class Real>
@@ -82,10 +93,10 @@ class ImmersedBoundary {
   // Call once per time step, right before fluid.step(). The fluid extent must
   // equal the box length. Spheres must not move between apply() and the
   // fluid step that uses its force.
-  void apply(lattice::FluidLattice<Real>& fluid, const spheres::SphereSet& spheres);
+  void apply(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& spheres);
 
   // Removes every force this object has put into the field.
-  void remove(lattice::FluidLattice<Real>& fluid);
+  void remove(lattice::ForcedLiquid<Real>& liquid);
 
   // Hydrodynamic force and torque (about the centre) on each sphere from the
   // last apply(): minus the sum of the marker forces and of their moments.
@@ -105,13 +116,15 @@ class ImmersedBoundary {
   void set_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular_momentum);
 
   // With measure_slip: root-mean-square and maximum over all markers of
-  // |u(X_m) - U_surface| after the last iteration of the last apply().
+  // |u(X_m) - U_surface| after the last sweep of the last apply().
   double rms_slip() const { return rms_slip_; }
   double max_slip() const { return max_slip_; }
 
  private:
   struct Workspace;
-  void zero_boxes(lattice::FluidLattice<Real>& fluid);
+  template <int W>  // kernel width
+  void apply_with_kernel(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& spheres);
+  void zero_boxes(const lattice::ForceFieldView<Real>& field);
 
   ImmersedBoundarySettings settings_;
   std::vector<Vec3> directions_;  // unit vectors of the markers

@@ -1,6 +1,8 @@
 #pragma once
-// The interpolation/spreading kernel of the immersed boundary: the 3-point
-// kernel of Roma, Peskin & Berger (1999), support |r| < 1.5 dx.
+// The interpolation/spreading kernels of the immersed boundary, per marker
+// and per direction: the weights of the cells a marker reads and forces.
+//
+// roma3: the 3-point kernel of Roma, Peskin & Berger (1999), support |r| < 1.5 dx.
 //
 // phi(r) = (1 + sqrt(1 - 3 r^2)) / 3                      |r| <= 1/2
 //        = (5 - 3|r| - sqrt(1 - 3 (1 - |r|)^2)) / 6        1/2 <= |r| <= 3/2
@@ -57,6 +59,28 @@ inline KernelWeights kernel_weights(double x) {
   k.first = static_cast<int>(nearest) - 1;
   roma_weights(x - nearest, k.w);
   return k;
+}
+
+// linear2: the 2-point linear hat, support |r| < 1 dx,
+//
+// phi(r) = 1 - |r|   |r| <= 1,   0 otherwise.
+//
+// It has the same two moment conditions (sum 1, first moment 0), so force and
+// torque are conserved exactly in spreading and linear fields interpolated
+// exactly, with 8 cells per marker instead of 27. It is only continuous, not
+// smooth: as a marker crosses a lattice node the weights change slope, which
+// makes the force on a moving sphere ripple at the lattice period (measured in
+// docs/immersed-boundary.md, "Options").
+inline double linear_kernel(double r) {
+  r = std::abs(r);
+  return r < 1.0 ? 1.0 - r : 0.0;
+}
+
+// The two weights of one direction for a marker at coordinate x: cells
+// first = floor(x) and first + 1, with d = x - floor(x) in [0, 1).
+inline void linear_weights(double d, double (&w)[2]) {
+  w[0] = 1.0 - d;
+  w[1] = d;
 }
 
 }  // namespace flocsim::immersed_boundary

@@ -184,22 +184,29 @@ void FluidLattice<Real>::enable_force_field() {
 }
 
 template <class Real>
-void FluidLattice<Real>::clear_force_field() {
-  if (!has_force_field()) return;
-  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
-  std::memset(force_x_.get(), 0, cells * sizeof(Real));
-  std::memset(force_y_.get(), 0, cells * sizeof(Real));
-  std::memset(force_z_.get(), 0, cells * sizeof(Real));
+ForceFieldView<Real> FluidLattice<Real>::force_field() {
+  enable_force_field();
+  return {extent_, {force_x_.get(), force_y_.get(), force_z_.get()}};
 }
 
 template <class Real>
-Real* FluidLattice<Real>::force_field(int component) {
-  return component == 0 ? force_x_.get() : component == 1 ? force_y_.get() : force_z_.get();
+ForceFieldView<const Real> FluidLattice<Real>::force_field_if_set() const {
+  return {extent_, {force_x_.get(), force_y_.get(), force_z_.get()}};
 }
 
 template <class Real>
-const Real* FluidLattice<Real>::force_field(int component) const {
-  return component == 0 ? force_x_.get() : component == 1 ? force_y_.get() : force_z_.get();
+void FluidLattice<Real>::save_slots(int i, std::vector<Real>& out) const {
+  const Real* from = storage(i);
+  out.assign(from, from + extent_.cells());
+}
+
+template <class Real>
+void FluidLattice<Real>::restore_slots(int i, const std::vector<Real>& in) {
+  if (static_cast<long>(in.size()) != extent_.cells())
+    throw std::invalid_argument("lattice: population slots of direction " + std::to_string(i) +
+                                " hold " + std::to_string(in.size()) + " values, the lattice has " +
+                                std::to_string(extent_.cells()) + " cells");
+  std::copy(in.begin(), in.end(), storage(i));
 }
 
 template <class Real>
@@ -231,7 +238,8 @@ Macroscopic FluidLattice<Real>::macroscopic(int x, int y, int z) const {
   double F[3] = {body_force_.x, body_force_.y, body_force_.z};
   if (has_force_field()) {
     const long c = wrapped_index(x, y, z);
-    for (int d = 0; d < 3; ++d) F[d] += force_field(d)[c];
+    const Real* field[3] = {force_x_.get(), force_y_.get(), force_z_.get()};
+    for (int d = 0; d < 3; ++d) F[d] += field[d][c];
   }
   Macroscopic m;
   m.density = 1.0 + drho;
@@ -326,46 +334,6 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
     for (int i = 0; i < kQ; ++i) f[i] = p[i][x0 + k];
     cell_moments(f, hx, hy, hz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
   }
-}
-
-template <class Real>
-void FluidLattice<Real>::macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy,
-                                                               Real* uz) const {
-  const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
-  const bool even = time_step_ % 2 == 0;
-  const Real hx = static_cast<Real>(0.5 * body_force_.x);
-  const Real hy = static_cast<Real>(0.5 * body_force_.y);
-  const Real hz = static_cast<Real>(0.5 * body_force_.z);
-  const Real* const base = populations_.get();
-  const long stride = stride_;
-#pragma omp parallel for collapse(2) schedule(static)
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y) {
-      const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
-      const Real* p[kQ];
-      current_population_rows(base, stride, nx, ny, nz, y, z, even, p);
-      Real* const r = density + row;
-      Real* const vx = ux + row;
-      Real* const vy = uy + row;
-      Real* const vz = uz + row;
-      const int x_begin = even ? 0 : 1;
-      const int x_end = even ? nx : nx - 1;
-#pragma omp simd
-      for (int x = x_begin; x < x_end; ++x) {
-        Real f[kQ];
-#pragma GCC unroll 19
-        for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
-        cell_moments(f, hx, hy, hz, r[x], vx[x], vy[x], vz[x]);
-      }
-      if (!even)
-        for (int x : {0, nx - 1}) {
-          const Macroscopic m = macroscopic_without_force_field(x, y, z);
-          r[x] = static_cast<Real>(m.density);
-          vx[x] = static_cast<Real>(m.velocity.x);
-          vy[x] = static_cast<Real>(m.velocity.y);
-          vz[x] = static_cast<Real>(m.velocity.z);
-        }
-    }
 }
 
 template <class Real>

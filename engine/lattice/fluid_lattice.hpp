@@ -27,18 +27,10 @@
 #include <vector>
 
 #include "engine/lattice/d3q19.hpp"
+#include "engine/lattice/forced_liquid.hpp"
 #include "engine/lattice/relaxation.hpp"
 
 namespace flocsim::lattice {
-
-struct Extent {
-  int nx = 1, ny = 1, nz = 1;
-  long cells() const { return static_cast<long>(nx) * ny * nz; }
-};
-
-struct Vector3 {
-  double x = 0, y = 0, z = 0;
-};
 
 // Density and velocity of one cell (velocity includes the half-force shift).
 struct Macroscopic {
@@ -47,14 +39,14 @@ struct Macroscopic {
 };
 
 template <class Real>
-class FluidLattice {
+class FluidLattice final : public ForcedLiquid<Real> {
  public:
   FluidLattice(Extent extent, Relaxation relaxation);
   ~FluidLattice();
   FluidLattice(const FluidLattice&) = delete;
   FluidLattice& operator=(const FluidLattice&) = delete;
 
-  const Extent& extent() const { return extent_; }
+  const Extent& extent() const override { return extent_; }
   const Relaxation& relaxation() const { return relaxation_; }
   long time_step() const { return time_step_; }
 
@@ -65,14 +57,13 @@ class FluidLattice {
 
   // ---- forcing --------------------------------------------------------------
   void set_body_force(Vector3 force_density) { body_force_ = force_density; }
-  Vector3 body_force() const { return body_force_; }
+  Vector3 body_force() const override { return body_force_; }
   // Allocates (zeroed) the per-cell force field; the kernel then reads it.
   void enable_force_field();
   bool has_force_field() const { return force_x_ != nullptr; }
-  Real* force_field(int component);  // 0, 1, 2 for x, y, z; index with cell_index
-  const Real* force_field(int component) const;
-  // Sets the whole per-cell force field to zero (no-op when not enabled).
-  void clear_force_field();
+  // The per-cell force field (enabled on first use); index with cell_index.
+  ForceFieldView<Real> force_field() override;
+  ForceFieldView<const Real> force_field_if_set() const override;
 
   // ---- state ----------------------------------------------------------------
   // Sets every cell to the equilibrium of the given density and (physical,
@@ -85,20 +76,12 @@ class FluidLattice {
   double population(int i, int x, int y, int z) const;
   Macroscopic macroscopic(int x, int y, int z) const;
   // Density and velocity with the half-force shift of the uniform body force
-  // only, ignoring the per-cell force field: the velocity the liquid would have
-  // without the immersed-boundary force (direct forcing needs it). x, y, z must
-  // lie inside the box. Cheaper than macroscopic(): no modulo for interior cells.
-  Macroscopic macroscopic_without_force_field(int x, int y, int z) const;
-  // The same for `count` consecutive cells x0 .. x0 + count - 1 of row (y, z)
-  // (inside the box, no wrap in x), written to density[k], ux[k], uy[k], uz[k].
+  // only, ignoring the per-cell force field (forced_liquid.hpp), for `count`
+  // consecutive cells x0 .. x0 + count - 1 of row (y, z) (no wrap in x).
   void macroscopic_row_without_force_field(int x0, int count, int y, int z, double* density,
-                                           double* ux, double* uy, double* uz) const;
-  // The same in the lattice's precision, interleaved: cell x0 + k gets
-  // (density, ux, uy, uz) at rho_u[4 k .. 4 k + 3] (the immersed boundary's layout).
-  void macroscopic_row_without_force_field(int x0, int count, int y, int z, Real* rho_u) const;
-  // The same for every cell, in one streaming pass over the populations
-  // (threads over rows), into arrays of length cells() indexed by cell_index.
-  void macroscopic_field_without_force_field(Real* density, Real* ux, Real* uy, Real* uz) const;
+                                           double* ux, double* uy, double* uz) const override;
+  void macroscopic_row_without_force_field(int x0, int count, int y, int z,
+                                           Real* rho_u) const override;
 
   // Density and velocity of every cell (arrays of length cells(), x fastest).
   void macroscopic_fields(std::vector<double>& density, std::vector<double>& ux,
@@ -113,9 +96,13 @@ class FluidLattice {
   // One lattice-Boltzmann step: collide with the current force, stream.
   void step();
 
-  // Raw storage, for checkpoints: populations (deviation form) of direction i.
-  Real* storage(int i) { return populations_.get() + i * stride_; }
-  const Real* storage(int i) const { return populations_.get() + i * stride_; }
+  // The state as stored, for checkpoints: the slot array of direction i
+  // (deviations from the rest equilibrium, cells() values in cell_index order,
+  // in the AA pattern's layout for the current time-step parity). Restore it
+  // into a lattice of the same extent and precision, with set_time_step(t) of
+  // the same parity, and the run continues bit for bit.
+  void save_slots(int i, std::vector<Real>& out) const;
+  void restore_slots(int i, const std::vector<Real>& in);
   void set_time_step(long t) { time_step_ = t; }
 
   // Bytes moved per cell update by step(), for roofline figures.
@@ -124,6 +111,11 @@ class FluidLattice {
  private:
   template <bool kForceField>
   void step_kernel();
+  Real* storage(int i) { return populations_.get() + i * stride_; }
+  const Real* storage(int i) const { return populations_.get() + i * stride_; }
+  // One cell of macroscopic_row_without_force_field (x, y, z inside the box);
+  // the row readers use it for the end cells whose upstream wraps in x.
+  Macroscopic macroscopic_without_force_field(int x, int y, int z) const;
   long wrapped_index(int x, int y, int z) const;
 
   struct FreeAligned {
@@ -145,7 +137,7 @@ template <class Real>
 template <class Field>
 void FluidLattice<Real>::initialise_equilibrium(Field&& field) {
   using namespace d3q19;
-  const Real* fields[3] = {force_field(0), force_field(1), force_field(2)};
+  const Real* fields[3] = {force_x_.get(), force_y_.get(), force_z_.get()};
   for (int z = 0; z < extent_.nz; ++z)
     for (int y = 0; y < extent_.ny; ++y)
       for (int x = 0; x < extent_.nx; ++x) {

@@ -32,13 +32,14 @@ void mark_solid_cells(const lattice::Extent& e, const std::vector<spheres::Vec3>
 }
 
 template <class Real>
-LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
+LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
                                const spheres::SphereSet& spheres,
                                std::vector<std::uint8_t>& solid) {
   const lattice::Extent e = fluid.extent();
   mark_solid_cells(e, spheres.position, spheres.radius, solid);
   const double body_x = fluid.body_force().x;
-  const Real* field_x = fluid.has_force_field() ? fluid.force_field(0) : nullptr;
+  const lattice::ForceFieldView<const Real> field = fluid.force_field_if_set();
+  const Real* field_x = field.component[0];
   double velocity_sum = 0, all_cells_sum = 0, momentum = 0, mass = 0;
   long liquid = 0;
 #pragma omp parallel reduction(+ : velocity_sum, all_cells_sum, momentum, mass, liquid)
@@ -51,12 +52,12 @@ LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
       // (sum c f + F_body / 2) / rho, without the per-cell field's half force
       fluid.macroscopic_row_without_force_field(0, e.nx, y, z, rho.data(), ux.data(), uy.data(),
                                                 uz.data());
-      const long base = fluid.cell_index(0, y, z);
+      const Real* row_field_x = field_x ? field.row(0, row) : nullptr;
       for (int x = 0; x < e.nx; ++x) {
         momentum += rho[x] * ux[x] - 0.5 * body_x;
         mass += rho[x];
-        const double field = field_x ? static_cast<double>(field_x[base + x]) : 0.0;
-        const double u = ux[x] + 0.5 * field / rho[x];
+        const double force = row_field_x ? static_cast<double>(row_field_x[x]) : 0.0;
+        const double u = ux[x] + 0.5 * force / rho[x];
         all_cells_sum += u;
         if (solid[static_cast<std::size_t>(row * e.nx + x)]) continue;
         velocity_sum += u;
@@ -73,9 +74,9 @@ LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
   return out;
 }
 
-template LiquidAverages liquid_averages(const lattice::FluidLattice<float>&,
+template LiquidAverages liquid_averages(const lattice::ForcedLiquid<float>&,
                                         const spheres::SphereSet&, std::vector<std::uint8_t>&);
-template LiquidAverages liquid_averages(const lattice::FluidLattice<double>&,
+template LiquidAverages liquid_averages(const lattice::ForcedLiquid<double>&,
                                         const spheres::SphereSet&, std::vector<std::uint8_t>&);
 
 }  // namespace flocsim::observables

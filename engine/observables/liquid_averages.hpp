@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lattice/forced_liquid.hpp"
 #include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::observables {
@@ -32,7 +32,7 @@ struct LiquidAverages {
 
 // `solid` is scratch space (one byte per cell), reused between calls.
 template <class Real>
-LiquidAverages liquid_averages(const lattice::FluidLattice<Real>& fluid,
+LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
                                const spheres::SphereSet& spheres, std::vector<std::uint8_t>& solid);
 
 // Marks (1) the cells whose centre (integer coordinates) lies within `radius`

@@ -19,8 +19,11 @@ template <class Real>
 void save_populations(output::Hdf5File& f, const lattice::FluidLattice<Real>& fluid) {
   f.create_group("/fluid");
   const std::vector<hsize_t> shape = {static_cast<hsize_t>(fluid.extent().cells())};
-  for (int i = 0; i < d3q19::kQ; ++i)
-    f.write("/fluid/population_deviation_" + std::to_string(i), shape, fluid.storage(i));
+  std::vector<Real> slots;
+  for (int i = 0; i < d3q19::kQ; ++i) {
+    fluid.save_slots(i, slots);
+    f.write("/fluid/population_deviation_" + std::to_string(i), shape, slots.data());
+  }
 }
 
 // `file` names the checkpoint in errors.
@@ -31,7 +34,7 @@ void restore_populations(output::Hdf5File& f, lattice::FluidLattice<Real>& fluid
     const auto data = f.read<Real>("/fluid/population_deviation_" + std::to_string(i));
     if (static_cast<long>(data.size()) != fluid.extent().cells())
       throw std::runtime_error(file.string() + ": population array has the wrong size");
-    std::copy(data.begin(), data.end(), fluid.storage(i));
+    fluid.restore_slots(i, data);
   }
 }
 

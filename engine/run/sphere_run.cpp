@@ -125,7 +125,7 @@ struct Liquid {
   std::vector<std::uint8_t> solid;  // scratch of the liquid averages
 
   explicit Liquid(const cases::SuspensionCase& c)
-      : fluid(c.box, {c.viscosity, c.trt_magic}), ib({c.input_radius, 0.7, 2, false}) {
+      : fluid(c.box, {c.viscosity, c.trt_magic}), ib({c.input_radius, c.ib_scheme, false}) {
     const double volume = static_cast<double>(c.box.cells());
     dynamics.external =
         spheres::settling_forces(static_cast<std::size_t>(c.sphere_count), c.radius_cells,

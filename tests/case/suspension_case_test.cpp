@@ -168,6 +168,35 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
       {{"scene", "granular"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 5}}}}));
 }
 
+// numerics.immersed_boundary: the preset's scheme by default (the paper's
+// method, written out in the canonical case), and a scheme the shipped
+// calibration does not hold at this resolution refused with its fields and
+// the command that would calibrate it.
+TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
+  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}});
+  EXPECT_EQ(c.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"],
+            json({{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}}));
+  const json odd = {
+      {"scene", "suspension"},
+      {"phi", 0.2},
+      {"numerics",
+       {{"immersed_boundary", {{"marker_spacing", 0.9}, {"sweeps", 3}, {"kernel", "linear2"}}}}}};
+  EXPECT_THAT(refusal(odd), AllOf(HasSubstr("numerics.immersed_boundary"),
+                                  HasSubstr("marker_spacing 0.9, sweeps 3, kernel linear2"),
+                                  HasSubstr("not calibrated at numerics.a_over_dx = 6"),
+                                  HasSubstr("flocsim calibrate --radius 6")));
+  const json typo = {{"scene", "suspension"},
+                     {"phi", 0.2},
+                     {"numerics", {{"immersed_boundary", {{"kernel", "roma4"}}}}}};
+  EXPECT_THAT(refusal(typo), AllOf(HasSubstr("numerics.immersed_boundary.kernel"),
+                                   HasSubstr("roma4"), HasSubstr("linear2")));
+  const json stray = {{"scene", "suspension"},
+                      {"phi", 0.2},
+                      {"numerics", {{"immersed_boundary", {{"spacing", 1.0}}}}}};
+  EXPECT_THAT(refusal(stray), AllOf(HasSubstr("spacing"), HasSubstr("marker_spacing")));
+}
+
 // A fixed array from a snapshot: N and phi come from the file, which must hold
 // spheres of the case's radius, inside its box, without overlap.
 TEST(SuspensionCase, FixedArrayFromASnapshot) {

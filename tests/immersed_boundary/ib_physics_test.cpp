@@ -22,7 +22,7 @@ using spheres::Vec3;
 template <class Real>
 double force_field_sum(const lattice::FluidLattice<Real>& fluid) {
   double s = 0;
-  for (long c = 0; c < fluid.extent().cells(); ++c) s += fluid.force_field(0)[c];
+  for (long c = 0; c < fluid.extent().cells(); ++c) s += fluid.force_field_if_set().component[0][c];
   return s;
 }
 
@@ -35,7 +35,7 @@ template <class Real>
 void momentum_balance(double tolerance) {
   const lattice::Extent e{40, 24, 24};
   lattice::FluidLattice<Real> fluid(e, {0.1, 0.25});
-  immersed_boundary::ImmersedBoundary<Real> ib({3.6, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<Real> ib({.input_radius = 3.6});
   spheres::SphereSet s;
   s.radius = 4.0;
   s.density_ratio = 4.0;
@@ -120,7 +120,7 @@ void creeping_settling(double a, int L, Vec3 start, int steps) {
   const double nu = 1.0 / 6.0;
   const double ag = test::calibrated_input_radius(a, nu);
   lattice::FluidLattice<double> fluid({L, L, L}, {nu, 0.25});
-  immersed_boundary::ImmersedBoundary<double> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<double> ib({.input_radius = ag});
   spheres::SphereSet s;
   s.radius = a;
   s.density_ratio = 4.0;
@@ -181,7 +181,7 @@ TEST(RotatingSphere, TorqueMatchesStokes) {
   const double a = 4.0, nu = 1.0 / 6.0;
   const double ag = test::calibrated_input_radius(a, nu);
   lattice::FluidLattice<double> fluid({L, L, L}, {nu, 0.25});
-  immersed_boundary::ImmersedBoundary<double> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<double> ib({.input_radius = ag});
   spheres::SphereSet s;
   s.radius = a;
   s.resize(1);

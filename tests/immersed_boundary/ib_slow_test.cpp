@@ -118,7 +118,7 @@ double settling_velocity_ratio(int W) {
   const double ag = test::calibrated_input_radius(a, nu);
   const int L = 2 * W;
   lattice::FluidLattice<float> fluid({L, W, W}, {nu, 0.25});
-  immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<float> ib({.input_radius = ag});
   SettlingSphere sphere(a, nu, re_inf, re_inf * nu / (2 * a), L, W);
   fluid.set_body_force({sphere.dyn.external.liquid_body_force.x(), 0, 0});
   const double u_sn = sphere.u_sn;
@@ -168,7 +168,7 @@ double sponge_settling_ratio(double re_inf, double W_over_a, double t_end, doubl
   const double ag = test::calibrated_input_radius(a, nu);
   const int L = static_cast<int>(16 * a), W = static_cast<int>(W_over_a * a);
   lattice::FluidLattice<float> fluid({L, W, W}, {nu, 0.25});
-  immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<float> ib({.input_radius = ag});
   test::WakeSponge<float> sponge(0.1, 8);
   SettlingSphere sphere(a, nu, re_inf, u_inf, L, W);
   fluid.set_body_force({sphere.dyn.external.liquid_body_force.x(), 0, 0});
@@ -276,7 +276,7 @@ void static_random_array(double phi, double re_wanted, double nu = 0.02) {
   s.velocity.assign(n, Vec3::Zero());
   s.angular_velocity.assign(n, Vec3::Zero());
   lattice::FluidLattice<float> fluid({L, L, L}, {nu, 0.25});
-  immersed_boundary::ImmersedBoundary<float> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<float> ib({.input_radius = ag});
   const double U_wanted = re_wanted * nu / (2 * a);
   // F_h = f V_p (1/phi - 1) = F 6 pi mu a U.
   const double f =

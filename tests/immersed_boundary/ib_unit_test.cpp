@@ -15,6 +15,7 @@
 #include "engine/immersed_boundary/kernel.hpp"
 #include "engine/immersed_boundary/sphere_markers.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
+#include "tests/lattice/lattice_probes.hpp"
 #include "wake_sponge.hpp"
 
 namespace flocsim {
@@ -43,6 +44,30 @@ TEST(RomaKernel, PartitionOfUnityAndZeroFirstMoment) {
   EXPECT_EQ(immersed_boundary::roma_kernel(1.5), 0.0);
 }
 
+TEST(LinearKernel, PartitionOfUnityAndZeroFirstMoment) {
+  // phi(r) = 1 - |r| on |r| < 1: at x, cells floor(x) and floor(x) + 1 carry
+  // 1 - d and d (d = x - floor x), which sum to 1 with first moment
+  // -d (1 - d) + (1 - d) d = 0.
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-20.0, 20.0);
+  for (int t = 0; t < 1000; ++t) {
+    const double x = u(rng), first = std::floor(x);
+    double w[2];
+    immersed_boundary::linear_weights(x - first, w);
+    double s0 = 0, s1 = 0;
+    for (int a = 0; a < 2; ++a) {
+      EXPECT_NEAR(w[a], immersed_boundary::linear_kernel(x - (first + a)), 1e-14);
+      s0 += w[a];
+      s1 += (x - (first + a)) * w[a];
+    }
+    EXPECT_NEAR(s0, 1.0, 1e-14);
+    EXPECT_NEAR(s1, 0.0, 1e-14);
+  }
+  EXPECT_EQ(immersed_boundary::linear_kernel(0.0), 1.0);
+  EXPECT_EQ(immersed_boundary::linear_kernel(1.0), 0.0);
+  EXPECT_EQ(immersed_boundary::linear_kernel(-0.25), 0.75);
+}
+
 // The velocity direct forcing starts from: the lattice velocity minus half of
 // the stored per-cell force over the density, at even and odd (AA) steps and
 // at cells on the periodic edges.
@@ -55,42 +80,31 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
                                 {0.01 * std::cos(y + z), 0.02 * std::sin(x), 0.005 * z}};
   });
   for (long c = 0; c < fluid.extent().cells(); ++c)
-    for (int d = 0; d < 3; ++d) fluid.force_field(d)[c] = 1e-4 * std::sin(3.0 * c + d);
+    for (int d = 0; d < 3; ++d) fluid.force_field().component[d][c] = 1e-4 * std::sin(3.0 * c + d);
   for (int step = 0; step < 2; ++step) {
     fluid.step();
     for (int z = 0; z < 6; ++z)
       for (int y = 0; y < 7; ++y)
         for (int x = 0; x < 9; ++x) {
           const auto full = fluid.macroscopic(x, y, z);
-          const auto bare = fluid.macroscopic_without_force_field(x, y, z);
+          const auto bare = testing::macroscopic_without_force_field(fluid, x, y, z);
           const long c = fluid.cell_index(x, y, z);
           EXPECT_NEAR(bare.density, full.density, 1e-15);
           EXPECT_NEAR(bare.velocity.x,
-                      full.velocity.x - 0.5 * fluid.force_field(0)[c] / full.density, 1e-15);
+                      full.velocity.x - 0.5 * fluid.force_field().component[0][c] / full.density,
+                      1e-15);
           EXPECT_NEAR(bare.velocity.y,
-                      full.velocity.y - 0.5 * fluid.force_field(1)[c] / full.density, 1e-15);
+                      full.velocity.y - 0.5 * fluid.force_field().component[1][c] / full.density,
+                      1e-15);
           EXPECT_NEAR(bare.velocity.z,
-                      full.velocity.z - 0.5 * fluid.force_field(2)[c] / full.density, 1e-15);
-        }
-    // The whole-field reader too.
-    const std::size_t cells = static_cast<std::size_t>(fluid.extent().cells());
-    std::vector<double> fr(cells), fx(cells), fy(cells), fz(cells);
-    fluid.macroscopic_field_without_force_field(fr.data(), fx.data(), fy.data(), fz.data());
-    for (int z = 0; z < 6; ++z)
-      for (int y = 0; y < 7; ++y)
-        for (int x = 0; x < 9; ++x) {
-          const auto bare = fluid.macroscopic_without_force_field(x, y, z);
-          const auto c = static_cast<std::size_t>(fluid.cell_index(x, y, z));
-          EXPECT_NEAR(fr[c], bare.density, 1e-15);
-          EXPECT_NEAR(fx[c], bare.velocity.x, 1e-15);
-          EXPECT_NEAR(fy[c], bare.velocity.y, 1e-15);
-          EXPECT_NEAR(fz[c], bare.velocity.z, 1e-15);
+                      full.velocity.z - 0.5 * fluid.force_field().component[2][c] / full.density,
+                      1e-15);
         }
     // The row reader gives the same numbers, edge cells included.
     double rho[9], ux[9], uy[9], uz[9];
     fluid.macroscopic_row_without_force_field(0, 9, 6, 5, rho, ux, uy, uz);
     for (int x = 0; x < 9; ++x) {
-      const auto bare = fluid.macroscopic_without_force_field(x, 6, 5);
+      const auto bare = testing::macroscopic_without_force_field(fluid, x, 6, 5);
       EXPECT_NEAR(rho[x], bare.density, 1e-15);
       EXPECT_NEAR(ux[x], bare.velocity.x, 1e-15);
       EXPECT_NEAR(uy[x], bare.velocity.y, 1e-15);
@@ -103,7 +117,7 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
       double rho_u[36];
       fluid.macroscopic_row_without_force_field(x0, count, 6, 5, rho_u);
       for (int k = 0; k < count; ++k) {
-        const auto bare = fluid.macroscopic_without_force_field(x0 + k, 6, 5);
+        const auto bare = testing::macroscopic_without_force_field(fluid, x0 + k, 6, 5);
         EXPECT_NEAR(rho_u[4 * k], bare.density, 1e-15);
         EXPECT_NEAR(rho_u[4 * k + 1], bare.velocity.x, 1e-15);
         EXPECT_NEAR(rho_u[4 * k + 2], bare.velocity.y, 1e-15);
@@ -111,8 +125,6 @@ TEST(FluidLattice, VelocityWithoutForceFieldRemovesHalfTheStoredForce) {
       }
     }
   }
-  fluid.clear_force_field();
-  EXPECT_EQ(fluid.force_field(2)[17], 0.0);
 }
 
 TEST(SphereMarkers, SpacingNearTheRequestedValue) {
@@ -177,7 +189,8 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.04), 5.59);
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.005), 5.57);  // outside: the nearest entry
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.5), 5.59);
-  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, 0.7, 1), 5.00);  // sweeps are a separate scheme
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, {0.7, 1, immersed_boundary::Kernel::roma3}),
+                   5.00);  // sweeps are a separate scheme
   EXPECT_DOUBLE_EQ(table.input_radius(4, 0.001), 3.53);
   EXPECT_THROW(table.input_radius(5, 0.02), std::out_of_range);
 }
@@ -233,7 +246,7 @@ TEST(WakeSponge, ConservesMomentumMixesTheSlabAndRemovesItsOldForce) {
     for (int x = 22; x < 26; ++x)
       for (int z = 0; z < e.nz; ++z)
         for (int y = 0; y < e.ny; ++y) {
-          m.push_back(f.macroscopic_without_force_field(x, y, z));
+          m.push_back(testing::macroscopic_without_force_field(f, x, y, z));
           mass += m.back().density;
           p[0] += m.back().density * m.back().velocity.x;
           p[1] += m.back().density * m.back().velocity.y;
@@ -252,7 +265,8 @@ TEST(WakeSponge, ConservesMomentumMixesTheSlabAndRemovesItsOldForce) {
     const bool in_slab = x >= 22 && x < 26;
     double sum = 0;
     for (int z = 0; z < e.nz; ++z)
-      for (int y = 0; y < e.ny; ++y) sum += std::abs(with.force_field(0)[with.cell_index(x, y, z)]);
+      for (int y = 0; y < e.ny; ++y)
+        sum += std::abs(with.force_field().component[0][with.cell_index(x, y, z)]);
     EXPECT_EQ(sum > 0, in_slab) << "x = " << x;
   }
   for (int step = 0; step < 20; ++step) {
@@ -282,7 +296,8 @@ TEST(WakeSponge, ConservesMomentumMixesTheSlabAndRemovesItsOldForce) {
   for (int x = 22; x < 27; ++x)
     for (int z = 0; z < e.nz; ++z)
       for (int y = 0; y < e.ny; ++y)
-        for (int d = 0; d < 3; ++d) EXPECT_EQ(with.force_field(d)[with.cell_index(x, y, z)], 0.0);
+        for (int d = 0; d < 3; ++d)
+          EXPECT_EQ(with.force_field().component[d][with.cell_index(x, y, z)], 0.0);
   EXPECT_THROW(sponge.apply(with, 0.3, 10.0), std::invalid_argument);  // slab would meet the sphere
 }
 
@@ -307,7 +322,7 @@ TEST(ImmersedBoundary, SpreadForceEqualsSphereReactionWithManySpheres) {
     return lattice::Macroscopic{
         1.0, {0.01 * std::sin(2 * M_PI * y / 40.0), 0.005 * std::cos(2 * M_PI * x / 64.0), 0}};
   });
-  immersed_boundary::ImmersedBoundary<double> ib({3.5, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<double> ib({.input_radius = 3.5});
   spheres::SphereSet s;
   s.radius = 4.0;
   std::mt19937 rng(7);
@@ -326,7 +341,8 @@ TEST(ImmersedBoundary, SpreadForceEqualsSphereReactionWithManySpheres) {
     for (int z = 0; z < 40; ++z)
       for (int y = 0; y < 40; ++y)
         for (int x = 0; x < 64; ++x)
-          for (int d = 0; d < 3; ++d) field[d] += fluid.force_field(d)[fluid.cell_index(x, y, z)];
+          for (int d = 0; d < 3; ++d)
+            field[d] += fluid.force_field().component[d][fluid.cell_index(x, y, z)];
     Vec3 total = Vec3::Zero();
     for (const Vec3& F : ib.force()) total += F;
     double scale = 0;
@@ -338,14 +354,15 @@ TEST(ImmersedBoundary, SpreadForceEqualsSphereReactionWithManySpheres) {
   ib.remove(fluid);
   double left = 0;
   for (int d = 0; d < 3; ++d)
-    for (long c = 0; c < fluid.extent().cells(); ++c) left += std::abs(fluid.force_field(d)[c]);
+    for (long c = 0; c < fluid.extent().cells(); ++c)
+      left += std::abs(fluid.force_field().component[d][c]);
   EXPECT_EQ(left, 0.0);
 }
 
 // The optimised apply() against a plain transcription of the method (header
 // of immersed_boundary.hpp) for spheres whose kernels do not overlap, two of
 // them across the periodic edges, at an even and an odd (AA) time step:
-// u* per cell from macroscopic_without_force_field, Roma weights from
+// u* per cell from testing::macroscopic_without_force_field, Roma weights from
 // roma_kernel, Jacobi sweeps interpolating u* + F/(2 rho) and spreading
 // dF = 2 rho (U - u), H = -sum F dV, T = -sum r x F dV, and the inside
 // momentum sum w (rho u* + F/2) with w = min(1, a_g + 1/2 - |r|).
@@ -355,9 +372,19 @@ struct ReferenceResult {
 };
 
 ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
-                                const spheres::SphereSet& s, double ag, int iterations) {
+                                const spheres::SphereSet& s, double ag,
+                                const immersed_boundary::Scheme& scheme) {
   const lattice::Extent e = fluid.extent();
-  const int n = immersed_boundary::marker_count(ag, 0.7);
+  const int n = immersed_boundary::marker_count(ag, scheme.marker_spacing);
+  const bool roma = scheme.kernel == immersed_boundary::Kernel::roma3;
+  const int width = roma ? 3 : 2;
+  // Roma: cells round(X) - 1 .. round(X) + 1; linear: floor(X), floor(X) + 1
+  const auto first_cell = [roma](double X) {
+    return roma ? static_cast<int>(std::nearbyint(X)) - 1 : static_cast<int>(std::floor(X));
+  };
+  const auto kernel = [roma](double r) {
+    return roma ? immersed_boundary::roma_kernel(r) : immersed_boundary::linear_kernel(r);
+  };
   const auto dirs = immersed_boundary::fibonacci_sphere(n);
   const double dV = immersed_boundary::marker_volume(ag, n);
   const auto wrap = [](int i, int L) { return ((i % L) + L) % L; };
@@ -378,8 +405,8 @@ ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
     for (int z = lo[2]; z < lo[2] + W; ++z)
       for (int y = lo[1]; y < lo[1] + W; ++y)
         for (int x = lo[0]; x < lo[0] + W; ++x) {
-          const auto m =
-              fluid.macroscopic_without_force_field(wrap(x, e.nx), wrap(y, e.ny), wrap(z, e.nz));
+          const auto m = testing::macroscopic_without_force_field(fluid, wrap(x, e.nx),
+                                                                  wrap(y, e.ny), wrap(z, e.nz));
           const std::size_t l = local(x, y, z);
           rho[l] = m.density;
           ux[l] = m.velocity.x;
@@ -388,19 +415,16 @@ ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
         }
     std::vector<Vec3> Fm(static_cast<std::size_t>(n), Vec3::Zero()), dF(Fm.size());
     const auto stencil = [&](const Vec3& X, auto&& visit) {
-      const int base[3] = {static_cast<int>(std::nearbyint(X[0])) - 1,
-                           static_cast<int>(std::nearbyint(X[1])) - 1,
-                           static_cast<int>(std::nearbyint(X[2])) - 1};
-      for (int k = 0; k < 3; ++k)
-        for (int j = 0; j < 3; ++j)
-          for (int i = 0; i < 3; ++i) {
-            const double w = immersed_boundary::roma_kernel(X[0] - (base[0] + i)) *
-                             immersed_boundary::roma_kernel(X[1] - (base[1] + j)) *
-                             immersed_boundary::roma_kernel(X[2] - (base[2] + k));
+      const int base[3] = {first_cell(X[0]), first_cell(X[1]), first_cell(X[2])};
+      for (int k = 0; k < width; ++k)
+        for (int j = 0; j < width; ++j)
+          for (int i = 0; i < width; ++i) {
+            const double w = kernel(X[0] - (base[0] + i)) * kernel(X[1] - (base[1] + j)) *
+                             kernel(X[2] - (base[2] + k));
             visit(local(base[0] + i, base[1] + j, base[2] + k), w);
           }
     };
-    for (int it = 0; it < iterations; ++it) {
+    for (int it = 0; it < scheme.sweeps; ++it) {
       for (int m = 0; m < n; ++m) {
         const Vec3 r = ag * dirs[static_cast<std::size_t>(m)];
         double rm = 0;
@@ -451,7 +475,10 @@ ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
   return out;
 }
 
-TEST(ImmersedBoundary, MatchesAPlainReferenceImplementation) {
+class ReferenceScheme : public ::testing::TestWithParam<immersed_boundary::Scheme> {};
+
+TEST_P(ReferenceScheme, MatchesAPlainReferenceImplementation) {
+  const immersed_boundary::Scheme scheme = GetParam();
   const lattice::Extent e{44, 36, 34};
   lattice::FluidLattice<double> fluid(e, {0.1, 0.25});
   fluid.set_body_force({2e-6, -1e-6, 0});
@@ -462,7 +489,7 @@ TEST(ImmersedBoundary, MatchesAPlainReferenceImplementation) {
                                  0.004 * std::sin(2 * M_PI * (x + y) / 36.0)}};
   });
   const double ag = 3.6;
-  immersed_boundary::ImmersedBoundary<double> ib({ag, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<double> ib({.input_radius = ag, .scheme = scheme});
   spheres::SphereSet s;
   s.radius = 4.0;
   // Kernels at least 3 dx apart; one sphere across x = 0, one across the
@@ -476,7 +503,7 @@ TEST(ImmersedBoundary, MatchesAPlainReferenceImplementation) {
       for (auto& x : s.position) x += Vec3(0.37, -0.21, 0.13);
     }
     ib.apply(fluid, s);
-    const ReferenceResult ref = reference_apply(fluid, s, ag, 2);
+    const ReferenceResult ref = reference_apply(fluid, s, ag, scheme);
     for (std::size_t p = 0; p < s.size(); ++p) {
       const double f = ref.force[p].norm(), t = ref.torque[p].norm();
       const double pm = ref.momentum[p].norm(), l = ref.angular[p].norm();
@@ -491,12 +518,27 @@ TEST(ImmersedBoundary, MatchesAPlainReferenceImplementation) {
     for (int d = 0; d < 3; ++d)
       for (long c = 0; c < e.cells(); ++c) {
         biggest = std::max(biggest, std::abs(ref.field[d][static_cast<std::size_t>(c)]));
-        worst = std::max(
-            worst, std::abs(fluid.force_field(d)[c] - ref.field[d][static_cast<std::size_t>(c)]));
+        worst = std::max(worst, std::abs(fluid.force_field().component[d][c] -
+                                         ref.field[d][static_cast<std::size_t>(c)]));
       }
     EXPECT_LT(worst, 1e-12 * biggest) << "step " << step;
   }
 }
+
+// The paper's scheme, one sweep, wider markers and the 2-point kernel.
+INSTANTIATE_TEST_SUITE_P(
+    Schemes, ReferenceScheme,
+    ::testing::Values(immersed_boundary::Scheme{0.7, 2, immersed_boundary::Kernel::roma3},
+                      immersed_boundary::Scheme{1.0, 1, immersed_boundary::Kernel::roma3},
+                      immersed_boundary::Scheme{0.7, 3, immersed_boundary::Kernel::roma3},
+                      immersed_boundary::Scheme{1.0, 1, immersed_boundary::Kernel::linear2},
+                      immersed_boundary::Scheme{0.7, 2, immersed_boundary::Kernel::linear2}),
+    [](const ::testing::TestParamInfo<immersed_boundary::Scheme>& info) {
+      const auto& p = info.param;
+      return immersed_boundary::kernel_name(p.kernel) + "_spacing" +
+             std::to_string(static_cast<int>(10 * p.marker_spacing)) + "_sweeps" +
+             std::to_string(p.sweeps);
+    });
 
 // The float lattice runs the same method in single precision (populations,
 // u*, marker sweeps): for the same flow its forces, torques and inside momenta
@@ -515,8 +557,8 @@ TEST(ImmersedBoundary, FloatAndDoubleLatticesAgree) {
   lattice::FluidLattice<float> ff(e, {0.1, 0.25});
   fd.initialise_equilibrium(flow);
   ff.initialise_equilibrium(flow);
-  immersed_boundary::ImmersedBoundary<double> ibd({3.6, 0.7, 2, false});
-  immersed_boundary::ImmersedBoundary<float> ibf({3.6, 0.7, 2, false});
+  immersed_boundary::ImmersedBoundary<double> ibd({.input_radius = 3.6});
+  immersed_boundary::ImmersedBoundary<float> ibf({.input_radius = 3.6});
   spheres::SphereSet s;
   s.radius = 4.0;
   s.position = {{0.7, 15.3, 14.9}, {21.4, 31.2, 0.45}, {24.1, 12.6, 19.3}};

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "engine/lattice/fluid_lattice.hpp"
+#include "tests/lattice/lattice_probes.hpp"
 
 namespace flocsim::test {
 
@@ -47,7 +48,7 @@ class WakeSponge {
                                   std::to_string(reach) + " + 16-cell chunks)");
     if (!fluid.has_force_field()) fluid.enable_force_field();
     for (std::size_t k = 0; k < cells_.size(); ++k)
-      for (int d = 0; d < 3; ++d) fluid.force_field(d)[cells_[k]] -= added_[3 * k + d];
+      for (int d = 0; d < 3; ++d) fluid.force_field().component[d][cells_[k]] -= added_[3 * k + d];
     cells_.clear();
     added_.clear();
     // The slab's cells and their velocity without the per-cell force field
@@ -59,7 +60,7 @@ class WakeSponge {
       const int x = ((centre - width_ / 2 + i) % e.nx + e.nx) % e.nx;
       for (int z = 0; z < e.nz; ++z)
         for (int y = 0; y < e.ny; ++y) {
-          const lattice::Macroscopic c = fluid.macroscopic_without_force_field(x, y, z);
+          const lattice::Macroscopic c = testing::macroscopic_without_force_field(fluid, x, y, z);
           cells_.push_back(fluid.cell_index(x, y, z));
           m.push_back(c);
           mass += c.density;
@@ -74,7 +75,7 @@ class WakeSponge {
       for (int d = 0; d < 3; ++d) {
         const auto f = static_cast<Real>(-rate_ * m[k].density * (u[d] - mean[d]));
         added_.push_back(f);
-        fluid.force_field(d)[cells_[k]] += f;
+        fluid.force_field().component[d][cells_[k]] += f;
       }
     }
   }

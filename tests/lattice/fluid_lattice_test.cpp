@@ -283,8 +283,8 @@ TEST(Conservation, PerCellForceFieldAddsItsSumToTheMomentum) {
   double total[3] = {0, 0, 0};
   for (long c = 0; c < fluid.extent().cells(); ++c)
     for (int d = 0; d < 3; ++d) {
-      fluid.force_field(d)[c] = u(rng);
-      total[d] += fluid.force_field(d)[c];
+      fluid.force_field().component[d][c] = u(rng);
+      total[d] += fluid.force_field().component[d][c];
     }
   // momentum reads include F/2 of the current force; compare after the same
   // read-out so that only the step's F enters the difference

@@ -64,7 +64,7 @@ void prescribed_field(double tolerance) {
   double field_sum = 0;
   for (long c = 0; c < kExtent.cells(); ++c)
     if (solid[static_cast<std::size_t>(c)]) {
-      fluid.force_field(0)[c] = static_cast<Real>(g);
+      fluid.force_field().component[0][c] = static_cast<Real>(g);
       field_sum += static_cast<Real>(g);
     }
   long solid_cells = 0;
