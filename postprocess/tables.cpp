@@ -57,7 +57,7 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
       if (!seen.insert(r.run.id).second) continue;  // a run shared by two sweeps: once
       RunSummary u;
       u.id = r.run.id;
-      u.status = r.run.status;
+      u.status = to_string(r.run.status);
       u.run_dir = r.run.run_dir;
       u.sweep = s.name;
       u.case_json = json::parse(r.run.case_json, nullptr, false);
