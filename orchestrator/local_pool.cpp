@@ -343,11 +343,12 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
           break;
         case process::kExitBadInput:
           state = RunState::kRefused;
-          why = "case refused (exit 2): " + tail;
+          why = "case refused (exit " + std::to_string(process::kExitBadInput) + "): " + tail;
           break;
         case process::kExitInterrupted:
           state = RunState::kInterrupted;
-          why = "stopped by a signal after writing a checkpoint (exit 3)";
+          why = "stopped by a signal after writing a checkpoint (exit " +
+                std::to_string(process::kExitInterrupted) + ")";
           break;
         default:
           state = RunState::kFailed;

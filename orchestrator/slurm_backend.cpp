@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "engine/process/exit_codes.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
@@ -218,8 +219,8 @@ int run_slurm_task(db::ResultsDb& db, const db::SweepRecord& sweep, const std::s
   p.job_id = job && index ? std::string(job) + "_" + index : (plain ? plain : "");
   p.out = &out;
   const PoolSummary s = run_pool(db, sweep, p);
-  if (s.stopped) return 3;
-  return s.failed + s.refused + s.lost > 0 ? 1 : 0;
+  if (s.stopped) return process::kExitInterrupted;
+  return s.failed + s.refused + s.lost > 0 ? process::kExitFailure : process::kExitOk;
 }
 
 int cancel_all(db::ResultsDb& db, std::ostream& out) {
