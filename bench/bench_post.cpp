@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < news.size(); ++k) {
       db::ClaimRequest req;
       req.sweep_id = sweep;
-      req.states = {"pending"};
+      req.states = {db::RunState::kPending};
       req.run_id = news[k].id;
       const auto claim = db.claim_run(req, start);
       const double phi = cases[k]["phi"], du = cases[k]["du_over_Uinf"];

@@ -173,6 +173,15 @@ class ResultsDb::Statement {
                            static_cast<std::size_t>(sqlite3_column_bytes(stmt_, c)))
              : std::string();
   }
+  // A run or attempt state; text the schema does not know is a DbError.
+  RunState state(int c) const {
+    try {
+      return run_state_from_string(text(c));
+    } catch (const std::invalid_argument& e) {
+      throw DbError(std::string(e.what()) + " in column " + sqlite3_column_name(stmt_, c) +
+                    " of: " + sqlite3_sql(stmt_));
+    }
+  }
   std::optional<double> opt_real(int c) const {
     return null(c) ? std::nullopt : std::optional<double>(real(c));
   }
@@ -483,7 +492,7 @@ std::vector<RunRecord> ResultsDb::runs(std::optional<std::int64_t> sweep_id) {
   if (sweep_id) s.bind(1, *sweep_id);
   std::vector<RunRecord> out;
   while (s.step())
-    out.push_back({s.text(0), s.text(1), s.text(2), s.text(3), s.text(4),
+    out.push_back({s.text(0), s.text(1), s.state(2), s.text(3), s.text(4),
                    static_cast<int>(s.i64(5)), static_cast<int>(s.i64(6)), s.text(7)});
   return out;
 }
@@ -495,7 +504,7 @@ std::optional<RunRecord> ResultsDb::find_run(const std::string& id) {
   if (!s.step()) return std::nullopt;
   return RunRecord{s.text(0),
                    s.text(1),
-                   s.text(2),
+                   s.state(2),
                    s.text(3),
                    s.text(4),
                    static_cast<int>(s.i64(5)),
@@ -505,15 +514,15 @@ std::optional<RunRecord> ResultsDb::find_run(const std::string& id) {
 
 std::vector<StateCount> ResultsDb::count_states(std::optional<std::int64_t> sweep_id) {
   check_owner();
-  std::map<std::string, int> counts;
-  for (const char* st : kRunStates) counts[st] = 0;
+  std::map<RunState, int> counts;
+  for (RunState st : kAllRunStates) counts[st] = 0;
   Statement s(db_, sweep_id ? "SELECT r.status, count(*) FROM sweep_runs sr JOIN runs r ON r.id "
                               "= sr.run_id WHERE sr.sweep_id = ?1 GROUP BY r.status"
                             : "SELECT status, count(*) FROM runs GROUP BY status");
   if (sweep_id) s.bind(1, *sweep_id);
-  while (s.step()) counts[s.text(0)] = static_cast<int>(s.i64(1));
+  while (s.step()) counts[s.state(0)] = static_cast<int>(s.i64(1));
   std::vector<StateCount> out;
-  for (const char* st : kRunStates) out.push_back({st, counts[st]});
+  for (RunState st : kAllRunStates) out.push_back({st, counts[st]});
   return out;
 }
 
@@ -541,12 +550,12 @@ std::optional<Claim> ResultsDb::claim_run(const ClaimRequest& request, const Att
     pick.bind(1, request.sweep_id).bind(2, request.max_attempts).bind(3, request.run_id);
     pick.bind(4, exclude);
     for (std::size_t i = 0; i < request.states.size(); ++i)
-      pick.bind(static_cast<int>(i + 5), request.states[i]);
+      pick.bind(static_cast<int>(i + 5), to_string(request.states[i]));
     if (!pick.step()) return std::nullopt;
     Claim c;
     c.run = {pick.text(0),
              pick.text(1),
-             pick.text(2),
+             pick.state(2),
              pick.text(3),
              pick.text(4),
              static_cast<int>(pick.i64(5)),
@@ -563,7 +572,7 @@ std::optional<Claim> ResultsDb::claim_run(const ClaimRequest& request, const Att
         .bind(4, start.host)
         .bind(5, start.owner_pid)
         .bind(6, start.job_id)
-        .bind(7, c.run.status != "pending" ? 1 : 0)
+        .bind(7, c.run.status != RunState::kPending ? 1 : 0)
         .bind(8, now)
         .run();
     c.attempt_id = sqlite3_last_insert_rowid(db_);
@@ -613,12 +622,11 @@ void ResultsDb::record_heartbeats(const std::vector<Heartbeat>& beats) {
   });
 }
 
-bool ResultsDb::end_attempt(std::int64_t attempt_id, const std::string& state,
-                            std::optional<int> exit_code, std::optional<int> signal,
-                            const std::string& error) {
+bool ResultsDb::end_attempt(std::int64_t attempt_id, RunState state, std::optional<int> exit_code,
+                            std::optional<int> signal, const std::string& error) {
   check_owner();
-  if (state == "running" || state == "completed")
-    throw DbError("end_attempt: state '" + state +
+  if (state == RunState::kPending || state == RunState::kRunning || state == RunState::kCompleted)
+    throw DbError("end_attempt: state '" + to_string(state) +
                   "' is not an ending state (record_result completes runs)");
   return write([&] {
     const double now = unix_now();
@@ -626,7 +634,7 @@ bool ResultsDb::end_attempt(std::int64_t attempt_id, const std::string& state,
                 "UPDATE attempts SET state = ?2, exit_code = ?3, signal = ?4, error = ?5, "
                 "ended_at = ?6 WHERE id = ?1 AND state = 'running'");
     s.bind(1, attempt_id)
-        .bind(2, state)
+        .bind(2, to_string(state))
         .bind(3, exit_code)
         .bind(4, signal)
         .bind(5, error)
@@ -636,7 +644,7 @@ bool ResultsDb::end_attempt(std::int64_t attempt_id, const std::string& state,
     Statement r(db_,
                 "UPDATE runs SET status = ?2, error = ?3, updated_at = ?4 WHERE id = (SELECT "
                 "run_id FROM attempts WHERE id = ?1) AND status = 'running'");
-    r.bind(1, attempt_id).bind(2, state).bind(3, error).bind(4, now).run();
+    r.bind(1, attempt_id).bind(2, to_string(state)).bind(3, error).bind(4, now).run();
     return true;
   });
 }
@@ -698,7 +706,7 @@ constexpr const char* kAttemptSelect =
     a.backend = stmt.text(3);                                         \
     a.host = stmt.text(4);                                            \
     a.job_id = stmt.text(5);                                          \
-    a.state = stmt.text(6);                                           \
+    a.state = stmt.state(6);                                          \
     a.log_path = stmt.text(7);                                        \
     a.error = stmt.text(8);                                           \
     a.pid = stmt.null(9) ? 0 : stmt.i64(9);                           \

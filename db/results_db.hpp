@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "db/run_state.hpp"
+
 struct sqlite3;
 
 namespace flocsim::db {
@@ -35,13 +37,8 @@ class ReadOnlyDbError : public DbError {
 
 inline constexpr int kSchemaVersion = 1;
 
-// Run states. A run is `pending` until first started, `running` while an
-// attempt is live, then ends `completed`, `failed` (exit 1 or crash),
-// `refused` (exit 2: the case was rejected, retrying cannot help),
-// `interrupted` (stopped by a signal after a checkpoint) or `lost` (the worker
-// vanished: kill -9, node loss, scheduler time-out, heartbeat lease expired).
-inline constexpr const char* kRunStates[] = {"pending", "running",     "completed", "failed",
-                                             "refused", "interrupted", "lost"};
+// Run and attempt states (RunState, with their stored text) are in
+// db/run_state.hpp.
 
 struct SweepRecord {
   std::int64_t id = 0;
@@ -55,7 +52,7 @@ struct SweepRecord {
 struct RunRecord {
   std::string id;         // SHA-256 of the canonical case, hex
   std::string case_json;  // canonical case
-  std::string status;
+  RunState status = RunState::kPending;
   std::string run_dir;
   std::string error;       // text of the last failure, empty when none
   int attempts = 0;        // attempts made
@@ -74,7 +71,9 @@ struct AttemptRecord {
   std::int64_t id = 0;
   std::string run_id;
   int number = 0;  // 1, 2, ... within the run
-  std::string backend, host, job_id, state, log_path, error;
+  std::string backend, host, job_id;
+  RunState state = RunState::kRunning;  // never kPending
+  std::string log_path, error;
   std::int64_t pid = 0, owner_pid = 0;
   std::string pid_start;  // process start time (from /proc), guards against pid reuse
   bool resumed = false;
@@ -112,7 +111,7 @@ struct ResultRecord {
 // skipping runs whose failures reached `max_attempts` and runs in `exclude`.
 struct ClaimRequest {
   std::int64_t sweep_id = 0;
-  std::vector<std::string> states;
+  std::vector<RunState> states;
   int max_attempts = 3;
   std::optional<std::string> run_id;  // only this run
   std::vector<std::string> exclude;   // never these runs (already tried by the caller)
@@ -124,7 +123,7 @@ struct Claim {
 };
 
 struct StateCount {
-  std::string status;
+  RunState status = RunState::kPending;
   int runs = 0;
 };
 
@@ -183,7 +182,7 @@ class ResultsDb {
   // Closes a live attempt in `state` (failed, refused, interrupted, lost) and
   // sets its run to the same state with `error`. A no-op when the attempt is
   // no longer running (someone else closed it first); returns whether it acted.
-  bool end_attempt(std::int64_t attempt_id, const std::string& state, std::optional<int> exit_code,
+  bool end_attempt(std::int64_t attempt_id, RunState state, std::optional<int> exit_code,
                    std::optional<int> signal, const std::string& error);
   // Records a completed run in one transaction: the result and its
   // observables, the attempt closed with exit code 0, the run completed.

@@ -22,6 +22,7 @@
 namespace flocsim::orchestrator {
 
 namespace fs = std::filesystem;
+using db::RunState;
 using db::unix_now;
 using nlohmann::json;
 
@@ -160,7 +161,7 @@ std::vector<Orphan> reconcile(db::ResultsDb& db, double lease_s, std::ostream* o
         const std::string why =
             "worker " + (a.pid > 0 ? "pid " + std::to_string(a.pid) : "(not started)") + " on " +
             host + " is gone and its orchestrator (pid " + std::to_string(a.owner_pid) + ") died";
-        if (db.end_attempt(a.id, "lost", std::nullopt, std::nullopt, why))
+        if (db.end_attempt(a.id, RunState::kLost, std::nullopt, std::nullopt, why))
           say(out, "lost       " + short_id(a.run_id) + ": " + why);
       }
       if (closed) ++*closed;
@@ -173,7 +174,7 @@ std::vector<Orphan> reconcile(db::ResultsDb& db, double lease_s, std::ostream* o
         char why[256];
         std::snprintf(why, sizeof why, "no heartbeat from %s (pid %lld) for %.0f s (lease %.0f s)",
                       a.host.c_str(), static_cast<long long>(a.pid), now - beat, lease_s);
-        if (db.end_attempt(a.id, "lost", std::nullopt, std::nullopt, why))
+        if (db.end_attempt(a.id, RunState::kLost, std::nullopt, std::nullopt, why))
           say(out, "lost       " + short_id(a.run_id) + ": " + why);
       }
       if (closed) ++*closed;
@@ -249,7 +250,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
     const auto counts = db.count_states(sweep.id);
     int done = 0;
     for (const auto& c : counts)
-      if (c.status == "completed") done = c.runs;
+      if (c.status == RunState::kCompleted) done = c.runs;
     return "[" + std::to_string(done) + "/" + std::to_string(total) + "]";
   };
 
@@ -283,7 +284,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
                        point_text(run.point_json) + " (result.json found complete on disk)");
         continue;
       }
-      const bool resume = run.status != "pending";
+      const bool resume = run.status != RunState::kPending;
       try {
         write_case_file(run.run_dir, run.case_json);
         std::vector<std::string> argv{o.worker, "run", run.run_dir + "/case.json", "--out",
@@ -304,7 +305,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
                        std::to_string(w.pid));
         workers.push_back(std::move(w));
       } catch (const std::exception& e) {
-        db.end_attempt(claim->attempt_id, "failed", std::nullopt, std::nullopt,
+        db.end_attempt(claim->attempt_id, RunState::kFailed, std::nullopt, std::nullopt,
                        std::string("could not start the worker: ") + e.what());
         ++sum.failed;
         say(o.out, "failed   " + short_id(run.id) + ": could not start the worker: " + e.what());
@@ -326,9 +327,10 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
       return;
     }
     const std::string tail = tail_of_file(w.run.run_dir + "/worker.log");
-    std::string state, why;
+    RunState state = RunState::kLost;
+    std::string why;
     if (w.lease_expired) {
-      state = "lost";
+      state = RunState::kLost;
       char buf[160];
       std::snprintf(buf, sizeof buf,
                     "no heartbeat (progress.json) for more than %.0f s; worker stopped", o.lease_s);
@@ -336,38 +338,40 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
     } else if (exit_code) {
       switch (*exit_code) {
         case process::kExitOk:
-          state = "failed";
+          state = RunState::kFailed;
           why = "worker exited 0 but its result is not usable: " + rr.problem;
           break;
         case process::kExitBadInput:
-          state = "refused";
-          why = "case refused (exit 2): " + tail;
+          state = RunState::kRefused;
+          why = "case refused (exit " + std::to_string(process::kExitBadInput) + "): " + tail;
           break;
         case process::kExitInterrupted:
-          state = "interrupted";
-          why = "stopped by a signal after writing a checkpoint (exit 3)";
+          state = RunState::kInterrupted;
+          why = "stopped by a signal after writing a checkpoint (exit " +
+                std::to_string(process::kExitInterrupted) + ")";
           break;
         default:
-          state = "failed";
+          state = RunState::kFailed;
           why = "exit code " + std::to_string(*exit_code) + ": " + tail;
       }
     } else if (sig) {
       const bool external = *sig == SIGKILL || *sig == SIGTERM || *sig == SIGINT || *sig == SIGHUP;
-      state = external ? "lost" : "failed";
+      state = external ? RunState::kLost : RunState::kFailed;
       why = "worker killed by " + signal_name(*sig) + (tail.empty() ? "" : ": " + tail);
     } else {
-      state = "lost";
+      state = RunState::kLost;
       why = "worker pid " + std::to_string(w.pid) +
             " ended unwatched (its orchestrator had died) without a result";
     }
     db.end_attempt(w.attempt_id, state, exit_code, sig, why);
-    if (state == "failed") ++sum.failed;
-    if (state == "refused") ++sum.refused;
-    if (state == "interrupted") ++sum.interrupted;
-    if (state == "lost") ++sum.lost;
+    if (state == RunState::kFailed) ++sum.failed;
+    if (state == RunState::kRefused) ++sum.refused;
+    if (state == RunState::kInterrupted) ++sum.interrupted;
+    if (state == RunState::kLost) ++sum.lost;
     const std::string first_line = why.substr(0, why.find('\n'));
-    say(o.out, progress_tag() + " " + state +
-                   (state.size() < 8 ? std::string(8 - state.size(), ' ') : "") + " " + tag + ": " +
+    const std::string name = to_string(state);
+    say(o.out, progress_tag() + " " + name +
+                   (name.size() < 8 ? std::string(8 - name.size(), ' ') : "") + " " + tag + ": " +
                    first_line);
   };
 

@@ -27,8 +27,11 @@ std::string default_runs_dir(const std::string& db_path);
 struct PoolOptions {
   std::string worker;  // the flocsim executable to run as `WORKER run CASE --out DIR`
   int jobs = 1;
-  std::vector<std::string> states{"pending", "interrupted", "lost"};  // what to (re)start
-  std::optional<std::vector<std::string>> only_runs;                  // restrict to these run ids
+  // what to (re)start
+  std::vector<db::RunState> states{db::RunState::kPending, db::RunState::kInterrupted,
+                                   db::RunState::kLost};
+  std::optional<std::vector<std::string>> only_runs;  // restrict to these run ids
+
   double lease_s = 60;   // a worker silent for longer is lost
   double poll_s = 0.2;   // how often children are checked
   double grace_s = 120;  // how long a stopping worker may take to checkpoint

@@ -12,6 +12,7 @@
 
 namespace flocsim::orchestrator {
 
+using db::RunState;
 using flocsim::input::InputError;
 using nlohmann::json;
 using nlohmann::ordered_json;
@@ -109,7 +110,7 @@ Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* c
       const json c = json::parse(r.run.case_json);
       row["run"] = r.run.id.substr(0, 12);
       row["sweep"] = s.name;
-      row["status"] = r.run.status;
+      row["status"] = to_string(r.run.status);
       for (const std::string& a : axes) row[a] = get_path(c, a).value_or(json());
       for (const db::Observable& ob : r.observables) {
         if (std::find(observables.begin(), observables.end(), ob.name) == observables.end())
@@ -353,7 +354,7 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
     const auto runs = db.runs(s.id);
     out << "sweep " << s.name << ": " << runs.size() << " runs\n ";
     for (const db::StateCount& c : db.count_states(s.id))
-      if (c.runs > 0 || c.status == "completed" || c.status == "pending")
+      if (c.runs > 0 || c.status == RunState::kCompleted || c.status == RunState::kPending)
         out << " " << c.status << " " << c.runs;
     out << "\n";
     // ETA: what running workers say, plus pending work at the mean wall time so far.
@@ -362,7 +363,8 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
     double running_eta = 0;
     for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
       if (r.wall_s) wall_sum += *r.wall_s, ++wall_n;
-      if (r.run.status == "pending" || r.run.status == "interrupted" || r.run.status == "lost")
+      if (r.run.status == RunState::kPending || r.run.status == RunState::kInterrupted ||
+          r.run.status == RunState::kLost)
         ++waiting;
     }
     bool header = false;
@@ -392,12 +394,12 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
       running_eta = std::max(running_eta, a.eta_s.value_or(0));
     }
     for (const db::RunRecord& r : runs) {
-      if (r.status != "failed" && r.status != "refused" && r.status != "lost" &&
-          r.status != "interrupted")
+      if (r.status != RunState::kFailed && r.status != RunState::kRefused &&
+          r.status != RunState::kLost && r.status != RunState::kInterrupted)
         continue;
       std::string err = r.error.substr(0, r.error.find('\n'));
       if (err.size() > 160) err = err.substr(0, 157) + "...";
-      const bool exhausted = r.status == "failed" && r.failures >= s.max_attempts;
+      const bool exhausted = r.status == RunState::kFailed && r.failures >= s.max_attempts;
       out << "  " << r.status << " " << r.id.substr(0, 12) << " " << r.point_json << " (attempts "
           << r.attempts << (exhausted ? ", retry limit reached" : "") << "): " << err << "\n";
     }

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "engine/process/exit_codes.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
@@ -21,6 +22,7 @@
 namespace flocsim::orchestrator {
 
 namespace fs = std::filesystem;
+using db::RunState;
 
 namespace {
 
@@ -109,7 +111,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   std::vector<db::RunRecord> to_submit;
   for (const db::RunRecord& r : db.runs(sweep.id)) {
     bool wanted = false;
-    for (const std::string& s : l.states) wanted = wanted || r.status == s;
+    for (RunState s : l.states) wanted = wanted || r.status == s;
     if (wanted && r.failures < sweep.max_attempts) to_submit.push_back(r);
   }
   if (to_submit.empty()) {
@@ -123,6 +125,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   fs::create_directories(job_dir);
   int tasks = 0;
   for (std::size_t i = 0; i < to_submit.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
+    // states go to the task file as their stored text (db/run_state.hpp to_json)
     nlohmann::json task{{"states", l.states}, {"runs", nlohmann::json::array()}};
     for (std::size_t j = i; j < std::min(to_submit.size(), i + static_cast<std::size_t>(per_task));
          ++j)
@@ -170,7 +173,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
     if (ok && queued.empty()) break;
     std::size_t done = 0;
     for (const db::StateCount& c : db.count_states(sweep.id))
-      if (c.status == "completed") done = static_cast<std::size_t>(c.runs);
+      if (c.status == RunState::kCompleted) done = static_cast<std::size_t>(c.runs);
     if (done != last_done) {
       say(l.out, "slurm: job " + sum.job_id + ": " + std::to_string(queued.size()) +
                      " task(s) queued or running; " + std::to_string(done) + " runs completed");
@@ -183,7 +186,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   for (const db::AttemptRecord& a : db.live_attempts()) {
     if (a.backend != "slurm" || a.job_id.rfind(sum.job_id + "_", 0) != 0) continue;
     if (process_alive(static_cast<pid_t>(a.owner_pid)) && a.host == host_name()) continue;
-    if (db.end_attempt(a.id, "lost", std::nullopt, std::nullopt,
+    if (db.end_attempt(a.id, RunState::kLost, std::nullopt, std::nullopt,
                        "Slurm job " + a.job_id + " left the queue while the run was open")) {
       ++sum.lost;
       say(l.out, "lost       " + a.run_id.substr(0, 12) + ": Slurm job " + a.job_id +
@@ -202,7 +205,11 @@ int run_slurm_task(db::ResultsDb& db, const db::SweepRecord& sweep, const std::s
   PoolOptions p;
   p.worker = worker;
   p.jobs = 1;
-  p.states = task.at("states").get<std::vector<std::string>>();
+  try {
+    p.states = task.at("states").get<std::vector<RunState>>();
+  } catch (const std::invalid_argument& e) {  // a state db/run_state.hpp does not know
+    throw std::runtime_error("Slurm task file " + task_file + ": " + e.what());
+  }
   p.only_runs = task.at("runs").get<std::vector<std::string>>();
   p.lease_s = lease_s;
   p.backend = "slurm";
@@ -212,8 +219,8 @@ int run_slurm_task(db::ResultsDb& db, const db::SweepRecord& sweep, const std::s
   p.job_id = job && index ? std::string(job) + "_" + index : (plain ? plain : "");
   p.out = &out;
   const PoolSummary s = run_pool(db, sweep, p);
-  if (s.stopped) return 3;
-  return s.failed + s.refused + s.lost > 0 ? 1 : 0;
+  if (s.stopped) return process::kExitInterrupted;
+  return s.failed + s.refused + s.lost > 0 ? process::kExitFailure : process::kExitOk;
 }
 
 int cancel_all(db::ResultsDb& db, std::ostream& out) {

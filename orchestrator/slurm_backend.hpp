@@ -18,7 +18,8 @@ namespace flocsim::orchestrator {
 struct SlurmLaunch {
   std::string worker;   // program run as `WORKER run CASE --out DIR` inside the tasks
   std::string flocsim;  // this flocsim, run as `flocsim sweep slurm-task` by each task
-  std::vector<std::string> states{"pending", "interrupted", "lost"};
+  std::vector<db::RunState> states{db::RunState::kPending, db::RunState::kInterrupted,
+                                   db::RunState::kLost};
   double lease_s = 60;
   bool wait = true;  // follow the job until it leaves the queue
   double poll_s = 1.0;

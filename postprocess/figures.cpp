@@ -118,7 +118,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
   FigureSet set;
   std::vector<const RunSummary*> done;
   for (const RunSummary& r : runs)
-    if (r.status == "completed" && r.F && r.Re) done.push_back(&r);
+    if (r.status == db::RunState::kCompleted && r.F && r.Re) done.push_back(&r);
   std::set<double> phis, res, dus;
   for (const RunSummary* r : done) {
     phis.insert(r->phi);

@@ -131,10 +131,11 @@ void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
       for (const auto& n : r.not_stationary) stationary += " " + n;
     }
     h << "<tr><td>" << escape(r.id.substr(0, 12)) << "</td><td>" << escape(r.sweep) << "</td><td"
-      << (r.status == "completed" ? "" : " class='bad'") << ">" << escape(r.status) << "</td><td>"
-      << r.phi << "</td><td>" << r.re_inf << "</td><td>" << r.du << "</td><td>"
-      << escape(r.fidelity) << "</td><td>" << escape(numerics) << "</td><td>" << window
-      << "</td><td>" << (r.sphere_count ? std::to_string(r.sphere_count) : "") << "</td><td>"
+      << (r.status == db::RunState::kCompleted ? "" : " class='bad'") << ">"
+      << escape(to_string(r.status)) << "</td><td>" << r.phi << "</td><td>" << r.re_inf
+      << "</td><td>" << r.du << "</td><td>" << escape(r.fidelity) << "</td><td>" << escape(numerics)
+      << "</td><td>" << window << "</td><td>"
+      << (r.sphere_count ? std::to_string(r.sphere_count) : "") << "</td><td>"
       << (r.has_result ? (r.errors_reliable ? "yes" : "no") : "") << "</td><td"
       << (r.not_stationary.empty() ? "" : " class='bad'") << ">" << escape(stationary)
       << "</td><td>" << wall << "</td><td>" << escape(r.flocsim_version) << "</td></tr>\n";

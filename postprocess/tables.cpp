@@ -98,7 +98,7 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
       for (const orchestrator::Filter& f : where) {
         json v;
         if (f.field == "status") {
-          v = u.status;
+          v = to_string(u.status);
         } else if (const auto c = orchestrator::get_path(u.case_json, f.field)) {
           v = *c;
         } else if (const auto o = observable(r, f.field)) {
@@ -131,14 +131,14 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
     row.run = &r;
     const auto it = zero_du.find(baseline_key(r.case_json));
     const RunSummary* base = it == zero_du.end() ? nullptr : it->second.front();
-    if (r.status != "completed" || !r.F || !r.n_a) {
-      row.reason = "this run is " + r.status + (r.has_result ? " (no F or <n_a>)" : "");
+    if (r.status != db::RunState::kCompleted || !r.F || !r.n_a) {
+      row.reason = "this run is " + to_string(r.status) + (r.has_result ? " (no F or <n_a>)" : "");
     } else if (!base) {
       row.reason =
           "no du = 0 run of the same case (same phi, Re_inf, fidelity, numerics, box, seed and "
           "protocol) in the database";
-    } else if (base->status != "completed" || !base->F || !base->n_a) {
-      row.reason = "its baseline " + base->id.substr(0, 12) + " is " + base->status;
+    } else if (base->status != db::RunState::kCompleted || !base->F || !base->n_a) {
+      row.reason = "its baseline " + base->id.substr(0, 12) + " is " + to_string(base->status);
     } else {
       row.baseline = base;
       row.F_over_F0 = ratio(*r.F, *base->F);
@@ -152,7 +152,7 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
 std::vector<NonAggregatingRow> non_aggregating_table(const std::vector<RunSummary>& runs) {
   std::vector<NonAggregatingRow> rows;
   for (const RunSummary& r : runs) {
-    if (r.du != 0 || r.status != "completed" || !r.F || !r.Re) continue;
+    if (r.du != 0 || r.status != db::RunState::kCompleted || !r.F || !r.Re) continue;
     NonAggregatingRow row;
     row.run = &r;
     row.beetstra = observables::beetstra_drag(r.phi, r.Re->mean);

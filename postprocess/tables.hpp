@@ -31,7 +31,9 @@ struct Measured {
 
 // One run of the database, with what the tables need from its result.json.
 struct RunSummary {
-  std::string id, status, run_dir, sweep;
+  std::string id;
+  db::RunState status = db::RunState::kPending;
+  std::string run_dir, sweep;
   nlohmann::json case_json;  // canonical case
   bool has_result = false;
   std::optional<Measured> U_over_Uinf, F, Re, Re_T, C_sph, n_a;

@@ -23,6 +23,7 @@ namespace flocsim::app {
 namespace {
 
 namespace orc = flocsim::orchestrator;
+using db::RunState;
 
 struct SweepOptions {
   std::string sweep_file, db_path, runs_dir, backend = "local", worker, sweep_name;
@@ -46,7 +47,7 @@ std::string default_worker() {
 int exit_code_for(db::ResultsDb& db, const db::SweepRecord& sweep, bool stopped) {
   if (stopped) return kExitInterrupted;
   for (const db::StateCount& c : db.count_states(sweep.id))
-    if (c.status != "completed" && c.runs > 0) return kExitFailure;
+    if (c.status != RunState::kCompleted && c.runs > 0) return kExitFailure;
   return kExitOk;
 }
 
@@ -57,7 +58,9 @@ void print_summary(const orc::PoolSummary& s, db::ResultsDb& db, const db::Sweep
   orc::write_status(db, sweep.name, std::cout);
   bool restartable = false;
   for (const db::StateCount& c : db.count_states(sweep.id))
-    if ((c.status == "failed" || c.status == "lost" || c.status == "interrupted") && c.runs > 0)
+    if ((c.status == RunState::kFailed || c.status == RunState::kLost ||
+         c.status == RunState::kInterrupted) &&
+        c.runs > 0)
       restartable = true;
   if (restartable)
     std::cout << "restart what did not finish with: flocsim sweep resume --db " << db.path()
@@ -80,7 +83,7 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 }
 
 int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
-              std::vector<std::string> states) {
+              std::vector<RunState> states) {
   if (o.backend == "slurm") {
     orc::SlurmLaunch launch;
     launch.worker = o.worker.empty() ? default_worker() : o.worker;
@@ -184,13 +187,16 @@ const bool registered = register_command(
                        << " new, " << reg.added.reused << " already in " << o->db_path
                        << "); run folders under " << std::filesystem::absolute(runs_dir).string()
                        << "\n";
-             return run_sweep(*o, db, reg.sweep, {"pending", "interrupted", "lost"});
+             return run_sweep(*o, db, reg.sweep,
+                              {RunState::kPending, RunState::kInterrupted, RunState::kLost});
            }
            if (*action == "resume") {
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
-             return run_sweep(*o, db, sweep, {"pending", "interrupted", "lost", "failed"});
+             return run_sweep(
+                 *o, db, sweep,
+                 {RunState::kPending, RunState::kInterrupted, RunState::kLost, RunState::kFailed});
            }
            if (*action == "status") {
              // status only reads, but where it may write it also marks workers

@@ -17,6 +17,7 @@ using flocsim::db::ClaimRequest;
 using flocsim::db::DbError;
 using flocsim::db::ResultRecord;
 using flocsim::db::ResultsDb;
+using flocsim::db::RunState;
 
 namespace {
 
@@ -139,13 +140,13 @@ TEST_F(DbTest, AddingRunsAgainReusesThemAndKeepsGridOrder) {
 TEST_F(DbTest, ClaimsPendingRunsInGridOrderOnce) {
   ResultsDb db(path_, ResultsDb::Mode::kCreate);
   const std::int64_t id = add_sweep(db, 3);
-  ClaimRequest req{id, {"pending"}, 2, std::nullopt, {}};
+  ClaimRequest req{id, {RunState::kPending}, 2, std::nullopt, {}};
   auto a = db.claim_run(req, start());
   auto b = db.claim_run(req, start());
   ASSERT_TRUE(a && b);
   EXPECT_EQ(a->run.id, "r0");
   EXPECT_EQ(b->run.id, "r1");
-  EXPECT_EQ(db.find_run("r0")->status, "running");
+  EXPECT_EQ(db.find_run("r0")->status, RunState::kRunning);
   const auto live = db.live_attempts();
   ASSERT_EQ(live.size(), 2u);
   EXPECT_EQ(live[0].number, 1);
@@ -162,19 +163,19 @@ TEST_F(DbTest, ClaimsPendingRunsInGridOrderOnce) {
 TEST_F(DbTest, FailuresCountAgainstTheRetryLimitAndKeepTheError) {
   ResultsDb db(path_, ResultsDb::Mode::kCreate);
   const std::int64_t id = add_sweep(db, 1);
-  ClaimRequest req{id, {"pending", "failed"}, 2, std::nullopt, {}};
+  ClaimRequest req{id, {RunState::kPending, RunState::kFailed}, 2, std::nullopt, {}};
   for (int attempt = 1; attempt <= 2; ++attempt) {
     auto c = db.claim_run(req, start());
     ASSERT_TRUE(c) << "attempt " << attempt;
     EXPECT_EQ(c->run.failures, attempt - 1);
-    EXPECT_TRUE(db.end_attempt(c->attempt_id, "failed", 1, std::nullopt,
+    EXPECT_TRUE(db.end_attempt(c->attempt_id, RunState::kFailed, 1, std::nullopt,
                                "blow-up " + std::to_string(attempt)));
     // A second close of the same attempt changes nothing.
-    EXPECT_FALSE(db.end_attempt(c->attempt_id, "lost", std::nullopt, 9, "late"));
+    EXPECT_FALSE(db.end_attempt(c->attempt_id, RunState::kLost, std::nullopt, 9, "late"));
   }
   EXPECT_FALSE(db.claim_run(req, start())) << "retry limit of 2 failures not applied";
   const auto run = db.find_run("r0");
-  EXPECT_EQ(run->status, "failed");
+  EXPECT_EQ(run->status, RunState::kFailed);
   EXPECT_EQ(run->error, "blow-up 2");
   EXPECT_EQ(run->attempts, 2);
   EXPECT_EQ(run->failures, 2);
@@ -189,22 +190,72 @@ TEST_F(DbTest, FailuresCountAgainstTheRetryLimitAndKeepTheError) {
 TEST_F(DbTest, LostAndInterruptedRunsDoNotCountAsFailures) {
   ResultsDb db(path_, ResultsDb::Mode::kCreate);
   const std::int64_t id = add_sweep(db, 1);
-  ClaimRequest req{id, {"pending", "lost", "interrupted"}, 1, std::nullopt, {}};
+  ClaimRequest req{
+      id, {RunState::kPending, RunState::kLost, RunState::kInterrupted}, 1, std::nullopt, {}};
   auto c1 = db.claim_run(req, start());
-  db.end_attempt(c1->attempt_id, "lost", std::nullopt, 9, "killed");
+  db.end_attempt(c1->attempt_id, RunState::kLost, std::nullopt, 9, "killed");
   auto c2 = db.claim_run(req, start());
   ASSERT_TRUE(c2);
-  db.end_attempt(c2->attempt_id, "interrupted", 3, std::nullopt, "stopped");
+  db.end_attempt(c2->attempt_id, RunState::kInterrupted, 3, std::nullopt, "stopped");
   auto c3 = db.claim_run(req, start());
   ASSERT_TRUE(c3);
-  EXPECT_EQ(c3->run.status, "interrupted");
+  EXPECT_EQ(c3->run.status, RunState::kInterrupted);
   EXPECT_EQ(db.find_attempt(c1->attempt_id)->signal, 9);
+}
+
+// Existing databases hold the states as text: every state's text is one the
+// schema accepts, reads back as that state and is counted in status order; a
+// text no state has is refused by name, not read as some state.
+TEST_F(DbTest, StoredStateTextsReadBackAsRunStates) {
+  const std::size_t n = std::size(flocsim::db::kAllRunStates);
+  std::int64_t id = 0;
+  {
+    ResultsDb db(path_, ResultsDb::Mode::kCreate);
+    id = add_sweep(db, static_cast<int>(n));
+  }
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &raw), SQLITE_OK);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string sql = "UPDATE runs SET status = '" +
+                            to_string(flocsim::db::kAllRunStates[i]) + "' WHERE id = 'r" +
+                            std::to_string(i) + "'";
+    EXPECT_EQ(sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+  }
+  {
+    ResultsDb db(path_, ResultsDb::Mode::kExisting);
+    const auto runs = db.runs(id);
+    ASSERT_EQ(runs.size(), n);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(runs[i].status, flocsim::db::kAllRunStates[i]);
+    const auto counts = db.count_states(id);
+    ASSERT_EQ(counts.size(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_EQ(counts[i].status, flocsim::db::kAllRunStates[i]);
+      EXPECT_EQ(counts[i].runs, 1) << counts[i].status;
+    }
+  }
+  // the schema's CHECK keeps unknown text out; switched off, it gets in
+  EXPECT_NE(sqlite3_exec(raw, "UPDATE runs SET status = 'cancelled' WHERE id = 'r0'", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_exec(raw, "PRAGMA ignore_check_constraints = ON", nullptr, nullptr, nullptr);
+  ASSERT_EQ(sqlite3_exec(raw, "UPDATE runs SET status = 'cancelled' WHERE id = 'r0'", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(raw);
+  ResultsDb db(path_, ResultsDb::Mode::kExisting);
+  try {
+    db.runs(id);
+    FAIL() << "an unknown state was read";
+  } catch (const DbError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown run state \"cancelled\""), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(DbTest, ResultIsRecordedOnceWithItsObservables) {
   ResultsDb db(path_, ResultsDb::Mode::kCreate);
   const std::int64_t id = add_sweep(db, 2);
-  ClaimRequest req{id, {"pending"}, 2, std::nullopt, {}};
+  ClaimRequest req{id, {RunState::kPending}, 2, std::nullopt, {}};
   auto c = db.claim_run(req, start());
   db.record_heartbeats({{c->attempt_id, 123.0, 0.5, 10.0, 2.0, 50, 100}});
   auto live = db.find_attempt(c->attempt_id);
@@ -215,8 +266,8 @@ TEST_F(DbTest, ResultIsRecordedOnceWithItsObservables) {
   EXPECT_TRUE(db.record_result(c->attempt_id, result(c->run.id, 12.5)));
   EXPECT_FALSE(db.record_result(c->attempt_id, result(c->run.id, 99.0)));
   EXPECT_EQ(db.count_results("r0"), 1);
-  EXPECT_EQ(db.find_run("r0")->status, "completed");
-  EXPECT_EQ(db.find_attempt(c->attempt_id)->state, "completed");
+  EXPECT_EQ(db.find_run("r0")->status, RunState::kCompleted);
+  EXPECT_EQ(db.find_attempt(c->attempt_id)->state, RunState::kCompleted);
   EXPECT_EQ(db.find_attempt(c->attempt_id)->exit_code, 0);
   const auto rows = db.result_rows(id);
   ASSERT_EQ(rows.size(), 2u);
@@ -230,12 +281,17 @@ TEST_F(DbTest, ResultIsRecordedOnceWithItsObservables) {
   EXPECT_DOUBLE_EQ(*rows[0].wall_s, 1.5);
   EXPECT_EQ(rows[0].window_json, "[1,2]");
   // Completed runs are never claimed again, whatever states are asked for.
-  ClaimRequest all{id, {"pending", "failed", "lost", "interrupted", "refused"}, 5, "r0", {}};
+  ClaimRequest all{id,
+                   {RunState::kPending, RunState::kFailed, RunState::kLost, RunState::kInterrupted,
+                    RunState::kRefused},
+                   5,
+                   "r0",
+                   {}};
   EXPECT_FALSE(db.claim_run(all, start()));
   const auto counts = db.count_states(id);
   for (const auto& s : counts) {
-    if (s.status == "completed") EXPECT_EQ(s.runs, 1);
-    if (s.status == "pending") EXPECT_EQ(s.runs, 1);
+    if (s.status == RunState::kCompleted) EXPECT_EQ(s.runs, 1);
+    if (s.status == RunState::kPending) EXPECT_EQ(s.runs, 1);
   }
 }
 
@@ -282,7 +338,7 @@ TEST_F(DbTest, ConcurrentClaimsFromManyProcessesNeverCollide) {
       try {
         ResultsDb db(path_, ResultsDb::Mode::kExisting);
         const auto sweep = db.find_sweep("s");
-        ClaimRequest req{sweep->id, {"pending"}, 2, std::nullopt, {}};
+        ClaimRequest req{sweep->id, {RunState::kPending}, 2, std::nullopt, {}};
         std::ofstream out(dir_ / ("claims_" + std::to_string(p)));
         while (auto c = db.claim_run(req, start())) {
           out << c->run.id << "\n";
@@ -315,7 +371,7 @@ TEST_F(DbTest, ConcurrentClaimsFromManyProcessesNeverCollide) {
   ResultsDb db(path_, ResultsDb::Mode::kExisting);
   EXPECT_EQ(db.integrity_check(), "ok");
   for (const auto& s : db.count_states())
-    EXPECT_EQ(s.runs, s.status == "completed" ? kRuns : 0) << s.status;
+    EXPECT_EQ(s.runs, s.status == RunState::kCompleted ? kRuns : 0) << s.status;
 }
 
 }  // namespace

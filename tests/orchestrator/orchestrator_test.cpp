@@ -18,6 +18,7 @@
 
 namespace fs = std::filesystem;
 using flocsim::db::ResultsDb;
+using flocsim::db::RunState;
 using nlohmann::json;
 namespace t = flocsim::test;
 
@@ -81,7 +82,8 @@ class Orchestrator : public ::testing::Test {
   std::map<double, std::string> statuses() {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
     std::map<double, std::string> out;
-    for (const auto& r : db.runs()) out[json::parse(r.case_json).value("x", -1.0)] = r.status;
+    for (const auto& r : db.runs())
+      out[json::parse(r.case_json).value("x", -1.0)] = to_string(r.status);
     return out;
   }
   int progress_step(double x) {
@@ -92,7 +94,7 @@ class Orchestrator : public ::testing::Test {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
     EXPECT_EQ(db.integrity_check(), "ok");
     for (const auto& r : db.runs())
-      EXPECT_EQ(db.count_results(r.id), r.status == "completed" ? 1 : 0) << r.case_json;
+      EXPECT_EQ(db.count_results(r.id), r.status == RunState::kCompleted ? 1 : 0) << r.case_json;
   }
 
   fs::path dir_;
@@ -176,7 +178,7 @@ TEST_F(Orchestrator, KilledWorkerIsLostThenResumedFromItsCheckpoint) {
   {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
     for (const auto& r : db.runs())
-      if (r.status == "lost") {
+      if (r.status == RunState::kLost) {
         const auto a = db.attempts(r.id);
         ASSERT_EQ(a.size(), 1u);
         EXPECT_EQ(a[0].signal, SIGKILL);
@@ -547,13 +549,13 @@ TEST_F(Orchestrator, RealFlocsimRunKilledMidRunResumesFromCheckpoint) {
   EXPECT_EQ(orch.wait(), 1) << t::read_text(dir_ / "launch.log");
   {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
-    EXPECT_EQ(db.runs().front().status, "lost");
+    EXPECT_EQ(db.runs().front().status, RunState::kLost);
   }
   const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_}));
   ASSERT_EQ(r.code, 0) << r.out;
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   const auto run = db.runs().front();
-  EXPECT_EQ(run.status, "completed");
+  EXPECT_EQ(run.status, RunState::kCompleted);
   const auto attempts = db.attempts(run.id);
   ASSERT_EQ(attempts.size(), 2u);
   EXPECT_TRUE(attempts[1].resumed);

@@ -12,6 +12,7 @@
 
 namespace fs = std::filesystem;
 using flocsim::db::ResultsDb;
+using flocsim::db::RunState;
 using nlohmann::json;
 namespace t = flocsim::test;
 
@@ -63,7 +64,7 @@ TEST_F(Slurm, CiSweepRunsAsAJobArrayWithTwoRunsPerTask) {
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   std::map<std::string, int> per_task;
   for (const auto& r : db.runs()) {
-    EXPECT_EQ(r.status, "completed");
+    EXPECT_EQ(r.status, RunState::kCompleted);
     EXPECT_EQ(db.count_results(r.id), 1);
     const auto a = db.attempts(r.id);
     ASSERT_EQ(a.size(), 1u);
@@ -106,14 +107,15 @@ TEST_F(Slurm, CancelledJobIsResumedFromCheckpointsByANewArray) {
   {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
     for (const auto& r : db.runs())
-      EXPECT_TRUE(r.status == "interrupted" || r.status == "lost") << r.status << " " << r.error;
+      EXPECT_TRUE(r.status == RunState::kInterrupted || r.status == RunState::kLost)
+          << r.status << " " << r.error;
   }
   const t::Output r = t::run(
       flocsim({"sweep", "resume", "--db", db_, "--backend", "slurm", "--worker", FAKE_WORKER_EXE}));
   ASSERT_EQ(r.code, 0) << r.out;
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   for (const auto& run : db.runs()) {
-    EXPECT_EQ(run.status, "completed");
+    EXPECT_EQ(run.status, RunState::kCompleted);
     EXPECT_EQ(db.count_results(run.id), 1);
     const json result = t::read_json(fs::path(run.run_dir) / "result.json");
     EXPECT_GE(result["observables"]["first_step"].get<int>(), 5);  // continued, not restarted

@@ -72,15 +72,16 @@ class Post : public ::testing::Test {
     start.host = "test";
     start.owner_pid = getpid();
     for (const HandRun& r : runs) {
-      if (r.state == "pending") continue;
+      const db::RunState state = db::run_state_from_string(r.state);
+      if (state == db::RunState::kPending) continue;
       db::ClaimRequest req;
       req.sweep_id = sweep;
-      req.states = {"pending"};
+      req.states = {db::RunState::kPending};
       req.run_id = r.id;
       const auto claim = db.claim_run(req, start);
-      if (r.state == "failed")
-        db.end_attempt(claim->attempt_id, "failed", 1, std::nullopt, "blew up");
-      if (r.state != "completed") continue;
+      if (state == db::RunState::kFailed)
+        db.end_attempt(claim->attempt_id, db::RunState::kFailed, 1, std::nullopt, "blew up");
+      if (state != db::RunState::kCompleted) continue;
       db::ResultRecord rec;
       rec.run_id = r.id;
       rec.flocsim_version = "test";
