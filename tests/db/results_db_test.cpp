@@ -290,8 +290,9 @@ TEST_F(DbTest, ResultIsRecordedOnceWithItsObservables) {
   EXPECT_FALSE(db.claim_run(all, start()));
   const auto counts = db.count_states(id);
   for (const auto& s : counts) {
-    if (s.status == RunState::kCompleted) EXPECT_EQ(s.runs, 1);
-    if (s.status == RunState::kPending) EXPECT_EQ(s.runs, 1);
+    if (s.status == RunState::kCompleted || s.status == RunState::kPending) {
+      EXPECT_EQ(s.runs, 1);
+    }
   }
 }
 

@@ -196,7 +196,9 @@ TEST_F(Orchestrator, KilledWorkerIsLostThenResumedFromItsCheckpoint) {
   EXPECT_GE(second, 5);
   const json rows = query();
   for (const json& row : rows)
-    if (row["x"] == 1) EXPECT_EQ(row["first_step"], second);
+    if (row["x"] == 1) {
+      EXPECT_EQ(row["first_step"], second);
+    }
   EXPECT_EQ(t::count_lines(run_dir(2) / "starts.log"), 1);  // the finished run did not rerun
   expect_one_result_per_completed_run();
 }
