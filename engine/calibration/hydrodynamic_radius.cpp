@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -64,53 +65,79 @@ double hydrodynamic_radius_from_drag(double force, double superficial_velocity, 
   return 0.5 * (lo + hi);
 }
 
+namespace {
+
+// The flow through one simple cubic array, kept between the passes of a
+// calibration: a new input radius changes the steady flow only slightly, so
+// each pass starts from the last one's flow instead of from rest (the steady
+// state reached is the same; the transient, most of the steps at low
+// viscosity, is not repeated).
+class ArrayFlow {
+ public:
+  ArrayFlow(int box, const ArrayDragSettings& settings)
+      : box_(box), settings_(settings), fluid_({box, box, box}, {settings.viscosity, 0.25}) {
+    sphere_.resize(1);
+    sphere_.position[0] = spheres::Vec3::Constant(0.5 * box);
+  }
+
+  ArrayDragResult run_to_steady(double input_radius) {
+    // The previous sphere's force leaves the lattice with it.
+    if (ib_) ib_->remove(fluid_);
+    ib_ = std::make_unique<immersed_boundary::ImmersedBoundary<double>>(
+        immersed_boundary::ImmersedBoundarySettings{input_radius, settings_.scheme, false});
+    sphere_.radius = input_radius;
+    // Body force from the reference drag of a sphere of radius a_g, so that U
+    // comes out near the requested superficial velocity.
+    const double cells = static_cast<double>(box_) * box_ * box_;
+    const double chi = std::min(0.95, 2.0 * input_radius / box_);
+    const double body_force = 6.0 * M_PI * settings_.viscosity * input_radius *
+                              sangani_acrivos_drag(chi) * settings_.superficial_velocity / cells;
+    fluid_.set_body_force({body_force, 0, 0});
+
+    ArrayDragResult r;
+    r.input_radius = input_radius;
+    r.box = box_;
+    r.body_force = body_force;
+    constexpr int kCheck = 100;
+    double previous = 0;
+    int calm = 0;
+    long step = 0;
+    while (step < settings_.max_steps) {
+      for (int s = 0; s < kCheck; ++s, ++step) {
+        ib_->apply(fluid_, sphere_);
+        fluid_.step();
+      }
+      const double u = fluid_.total_momentum().x / fluid_.total_mass();
+      if (!std::isfinite(u)) throw std::runtime_error("simple cubic array: velocity not finite");
+      calm = std::abs(u - previous) <= settings_.tolerance * std::abs(u) ? calm + 1 : 0;
+      previous = u;
+      if (calm >= 3) break;
+    }
+    if (calm < 3)
+      throw std::runtime_error("simple cubic array (a_g = " + std::to_string(input_radius) +
+                               ", L = " + std::to_string(box_) + "): no steady state within " +
+                               std::to_string(settings_.max_steps) + " steps");
+    r.superficial_velocity = previous;
+    r.ib_force = std::abs(ib_->force()[0].x());
+    r.steps = step;
+    r.hydrodynamic_radius = hydrodynamic_radius_from_drag(
+        body_force * cells, r.superficial_velocity, settings_.viscosity, box_);
+    return r;
+  }
+
+ private:
+  int box_;
+  ArrayDragSettings settings_;
+  lattice::FluidLattice<double> fluid_;
+  spheres::SphereSet sphere_;
+  std::unique_ptr<immersed_boundary::ImmersedBoundary<double>> ib_;
+};
+
+}  // namespace
+
 ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
                                         const ArrayDragSettings& settings) {
-  lattice::FluidLattice<double> fluid({box, box, box}, {settings.viscosity, 0.25});
-  immersed_boundary::ImmersedBoundary<double> ib({input_radius, settings.scheme, false});
-  spheres::SphereSet sphere;
-  sphere.radius = input_radius;
-  sphere.resize(1);
-  sphere.position[0] = spheres::Vec3::Constant(0.5 * box);
-  // Body force from the reference drag of a sphere of radius a_g, so that U
-  // comes out near the requested superficial velocity.
-  const double chi = std::min(0.95, 2.0 * input_radius / box);
-  const double body_force = 6.0 * M_PI * settings.viscosity * input_radius *
-                            sangani_acrivos_drag(chi) * settings.superficial_velocity /
-                            (static_cast<double>(box) * box * box);
-  fluid.set_body_force({body_force, 0, 0});
-  const double cells = static_cast<double>(box) * box * box;
-
-  ArrayDragResult r;
-  r.input_radius = input_radius;
-  r.box = box;
-  r.body_force = body_force;
-  constexpr int kCheck = 100;
-  double previous = 0;
-  int calm = 0;
-  long step = 0;
-  while (step < settings.max_steps) {
-    for (int s = 0; s < kCheck; ++s, ++step) {
-      ib.apply(fluid, sphere);
-      fluid.step();
-    }
-    const double u = fluid.total_momentum().x / fluid.total_mass();
-    if (!std::isfinite(u)) throw std::runtime_error("simple cubic array: velocity not finite");
-    calm = std::abs(u - previous) <= settings.tolerance * std::abs(u) ? calm + 1 : 0;
-    previous = u;
-    if (calm >= 3) break;
-  }
-  if (calm < 3)
-    throw std::runtime_error("simple cubic array (a_g = " + std::to_string(input_radius) +
-                             ", L = " + std::to_string(box) + "): no steady state within " +
-                             std::to_string(settings.max_steps) + " steps");
-  (void)cells;
-  r.superficial_velocity = previous;
-  r.ib_force = std::abs(ib.force()[0].x());
-  r.steps = step;
-  r.hydrodynamic_radius = hydrodynamic_radius_from_drag(body_force * cells, r.superficial_velocity,
-                                                        settings.viscosity, box);
-  return r;
+  return ArrayFlow(box, settings).run_to_steady(input_radius);
 }
 
 CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::vector<int>& boxes,
@@ -121,12 +148,14 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
   e.hydrodynamic_radius = hydrodynamic_radius;
   e.viscosity = settings.viscosity;
   e.scheme = settings.scheme;
+  std::vector<std::unique_ptr<ArrayFlow>> flows;
+  for (int L : boxes) flows.push_back(std::make_unique<ArrayFlow>(L, settings));
   double ag = hydrodynamic_radius - 0.3;  // typical offset, refined below
   for (int pass = 0; pass < 3; ++pass) {
     e.checks.clear();
     double mean_offset = 0;
-    for (int L : boxes) {
-      e.checks.push_back(simple_cubic_array_drag(ag, L, settings));
+    for (auto& flow : flows) {
+      e.checks.push_back(flow->run_to_steady(ag));
       if (progress) progress(e.checks.back());
       mean_offset += e.checks.back().hydrodynamic_radius - ag;
     }

@@ -43,7 +43,7 @@ struct ArrayDragResult {
   double body_force = 0;            // f
   double superficial_velocity = 0;  // U
   double ib_force = 0;              // |H_x| on the sphere at the end (equals f L^3 when steady)
-  long steps = 0;
+  long steps = 0;  // steps of this run (a calibration pass starts from the last flow)
   double hydrodynamic_radius = 0;  // root of K_measured(a) = K_SA(2a/L)
   // K for a given radius a: F / (6 pi nu a U).
   double drag_coefficient(double a, double viscosity) const;

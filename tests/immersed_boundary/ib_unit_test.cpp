@@ -533,8 +533,8 @@ INSTANTIATE_TEST_SUITE_P(
                       immersed_boundary::Scheme{0.7, 3, immersed_boundary::Kernel::roma3},
                       immersed_boundary::Scheme{1.0, 1, immersed_boundary::Kernel::linear2},
                       immersed_boundary::Scheme{0.7, 2, immersed_boundary::Kernel::linear2}),
-    [](const ::testing::TestParamInfo<immersed_boundary::Scheme>& info) {
-      const auto& p = info.param;
+    [](const ::testing::TestParamInfo<immersed_boundary::Scheme>& param_info) {
+      const auto& p = param_info.param;
       return immersed_boundary::kernel_name(p.kernel) + "_spacing" +
              std::to_string(static_cast<int>(10 * p.marker_spacing)) + "_sweeps" +
              std::to_string(p.sweeps);
