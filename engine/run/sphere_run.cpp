@@ -49,20 +49,7 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// ---- which modules a scene composes ------------------------------------------
-struct SceneModules {
-  bool liquid = false;       // lattice liquid + immersed boundary
-  bool spheres_move = true;  // sphere equations of motion (else held still)
-  bool contacts = false;     // event-driven collisions and square well
-  bool lubrication = false;  // radial lubrication below s0
-};
-
-SceneModules modules_of(const std::string& scene) {
-  if (scene == "suspension") return {true, true, true, true};
-  if (scene == "fixed-array") return {true, false, false, false};
-  if (scene == "single-sphere") return {true, true, false, false};
-  return {false, true, true, false};  // granular
-}
+using cases::SceneModules;
 
 // ---- time series -------------------------------------------------------------
 // Columns sampled every protocol.sample_every a/U_inf; scenes with a liquid add
@@ -385,7 +372,7 @@ nlohmann::json steady(const std::vector<double>& samples) {
 void place_spheres(const cases::SuspensionCase& c, const SceneModules& m,
                    const spheres::PeriodicBox& box, spheres::SphereSet& s) {
   s.resize(static_cast<std::size_t>(c.sphere_count));
-  if (c.scene == "single-sphere") {
+  if (c.scene == cases::Scene::single_sphere) {
     s.position[0] = 0.5 * box.length;
     return;
   }
@@ -430,7 +417,7 @@ std::string health(const spheres::SphereSet& s, double liquid_mass) {
 
 template <class Real>
 RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
-  const SceneModules modules = modules_of(c.scene);
+  const SceneModules& modules = cases::modules_of(c.scene);
   const StartMode start = prepare_output_directory(o.out_dir, o.resume, c.to_json());
   RunLog log(o.out_dir / "run.log", o.quiet);
   if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
@@ -469,8 +456,9 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   } else {
     place_spheres(c, modules, box, s.spheres);
   }
-  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " " + c.scene + " scene: " +
-           std::to_string(c.sphere_count) + " spheres of radius " + std::to_string(c.radius_cells) +
+  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " " +
+           std::string(cases::scene_name(c.scene)) + " scene: " + std::to_string(c.sphere_count) +
+           " spheres of radius " + std::to_string(c.radius_cells) +
            (modules.liquid ? " (markers at a_g = " + std::to_string(c.input_radius) + ")" : "") +
            " in " + std::to_string(c.box.nx) + " x " + std::to_string(c.box.ny) + " x " +
            std::to_string(c.box.nz) + ", phi = " + std::to_string(c.phi_realised) +
@@ -712,13 +700,13 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     ref["beetstra_F_at_measured_Re"] = observables::beetstra_drag(phi, re);
     ref["beetstra_normalisation"] =
         "F = F_h / (6 pi mu a U), F_h = f V_p (1/phi - 1), U superficial, Re = 2aU/nu";
-    if (c.scene == "suspension") {
+    if (c.scene == cases::Scene::suspension) {
       ref["richardson_zaki_U_over_Uinf"] =
           observables::richardson_zaki_velocity_ratio(phi, c.reynolds_inf);
       ref["richardson_zaki_exponent"] = observables::richardson_zaki_exponent(c.reynolds_inf);
       ref["beetstra_U_over_Uinf"] = observables::beetstra_velocity_ratio(phi, c.reynolds_inf);
     }
-    if (c.scene == "single-sphere" && c.box.nx == c.box.ny && c.box.ny == c.box.nz) {
+    if (c.scene == cases::Scene::single_sphere && c.box.nx == c.box.ny && c.box.ny == c.box.nz) {
       // creeping-flow hindrance of the simple cubic array the periodic box makes
       ref["sangani_acrivos_K"] = calibration::sangani_acrivos_drag(2 * a / c.box.nx);
     }
@@ -842,18 +830,14 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
 
 }  // namespace
 
-const std::vector<std::string>& runnable_sphere_scenes() {
-  static const std::vector<std::string> scenes = {"suspension", "fixed-array", "single-sphere",
-                                                  "granular"};
-  return scenes;
-}
-
 RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
-  if (std::find(runnable_sphere_scenes().begin(), runnable_sphere_scenes().end(), c.scene) ==
-      runnable_sphere_scenes().end())
-    throw input::InputError("scene = \"" + c.scene +
-                            "\": must be one of suspension, fixed-array, single-sphere, "
-                            "granular, fluid");
+  if (!cases::modules_of(c.scene).spheres) {
+    std::string list;
+    for (const auto& n : cases::scene_names(/*with_spheres=*/true))
+      list += (list.empty() ? "\"" : ", \"") + n + "\"";
+    throw input::InputError("scene = \"" + std::string(cases::scene_name(c.scene)) +
+                            "\": has no spheres; the sphere run takes " + list);
+  }
   try {
     return c.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
   } catch (const input::InputError&) {

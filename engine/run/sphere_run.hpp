@@ -1,6 +1,6 @@
 #pragma once
 // The time loop of the scenes with spheres. It composes only the modules a
-// scene needs (docs/architecture.md), in this order within a time step:
+// scene needs (cases::kScenes), in this order within a time step:
 //
 //   scene          liquid + IB   sphere motion      lubrication   direct interactions
 //   suspension     yes           IB + gravity       yes           yes (events)
@@ -38,9 +38,7 @@
 
 namespace flocsim::run {
 
-// Scenes run_sphere_case can run in this build.
-const std::vector<std::string>& runnable_sphere_scenes();
-
+// A scene without spheres is refused (input::InputError).
 RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& options);
 
 }  // namespace flocsim::run
