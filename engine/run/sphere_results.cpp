@@ -63,20 +63,17 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
   };
   auto key = [](std::string_view name) { return std::string(name); };
   nlohmann::json obs;
-  obs[key(observable::C_sph)] = steady(window(column::C_sph));
-  obs[key(observable::n_a_mean)] = steady(window(column::mean_aggregate_size));
-  obs[key(observable::granular_temperature)] = steady(window(column::granular_temperature));
-  obs[key(observable::Re_T)] = steady(window(column::Re_T));
+  // the steady averages the time series' columns declare
+  for (const auto& col : kSphereColumns)
+    if (!col.steady_average.empty()) obs[key(col.steady_average)] = steady(window(col.name));
   if (modules.liquid) {
-    obs[key(observable::U_over_Uinf)] = steady(window(column::U_over_Uinf));
-    obs[key(observable::U)] = steady(window(column::U));
-    obs[key(observable::F)] = steady(window(column::F));
+    for (const auto& col : kLiquidColumns)
+      if (!col.steady_average.empty()) obs[key(col.steady_average)] = steady(window(col.name));
     // F with <u> over every cell (docs/validation.md, "Which <u>"); F is the
     // liquid-only reading flocsim reports
     const auto f_all = window(column::F_all_cells);
     if (std::none_of(f_all.begin(), f_all.end(), [](double v) { return std::isnan(v); }))
       obs[key(observable::F_all_cells)] = steady(f_all);
-    obs[key(observable::Re)] = steady(window(column::Re));
     const double phi = c.phi_realised;
     const double re = obs[key(observable::Re)]["mean"].get<double>();
     nlohmann::json ref;

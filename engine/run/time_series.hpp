@@ -6,9 +6,12 @@
 // fall out of step. Scenes with a liquid add the settling observables of
 // docs/model.md section 4.
 //
+// A column may name the result.json observable that is its steady average
+// over the statistics window (sphere_results.cpp reports every such one).
+//
 // A new column: a field in SphereSample or LiquidSample, its row in the
-// table beside it (name from engine/result_names), and its value where the
-// sphere run samples.
+// table beside it (names from engine/result_names), and its value where the
+// sphere run samples (take_sample in sphere_run.cpp).
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -49,32 +52,37 @@ template <class Sample>
 struct Column {
   std::string_view name;
   double Sample::*value;
+  std::string_view steady_average = {};  // its result.json observable; empty: none
 };
 
 namespace column_names = result_names::column;
+namespace observable_names = result_names::observable;
 
 inline constexpr Column<SphereSample> kSphereColumns[] = {
     {column_names::step, &SphereSample::step},
     {column_names::time, &SphereSample::time},
     {column_names::stage, &SphereSample::stage},
-    {column_names::C_sph, &SphereSample::C_sph},
-    {column_names::mean_aggregate_size, &SphereSample::mean_aggregate_size},
-    {column_names::granular_temperature, &SphereSample::granular_temperature},
-    {column_names::Re_T, &SphereSample::Re_T},
+    {column_names::C_sph, &SphereSample::C_sph, observable_names::C_sph},
+    {column_names::mean_aggregate_size, &SphereSample::mean_aggregate_size,
+     observable_names::n_a_mean},
+    {column_names::granular_temperature, &SphereSample::granular_temperature,
+     observable_names::granular_temperature},
+    {column_names::Re_T, &SphereSample::Re_T, observable_names::Re_T},
     {column_names::kinetic_energy, &SphereSample::kinetic_energy},
     {column_names::well_energy, &SphereSample::well_energy},
     {column_names::collisions, &SphereSample::collisions},
 };
 
 inline constexpr Column<LiquidSample> kLiquidColumns[] = {
-    {column_names::U_over_Uinf, &LiquidSample::U_over_Uinf},
-    {column_names::U, &LiquidSample::U},
-    {column_names::F, &LiquidSample::F},
-    {column_names::Re, &LiquidSample::Re},
+    {column_names::U_over_Uinf, &LiquidSample::U_over_Uinf, observable_names::U_over_Uinf},
+    {column_names::U, &LiquidSample::U, observable_names::U},
+    {column_names::F, &LiquidSample::F, observable_names::F},
+    {column_names::Re, &LiquidSample::Re, observable_names::Re},
     {column_names::liquid_velocity, &LiquidSample::liquid_velocity},
     {column_names::sphere_velocity, &LiquidSample::sphere_velocity},
     {column_names::momentum_balance, &LiquidSample::momentum_balance},
     {column_names::liquid_velocity_all_cells, &LiquidSample::liquid_velocity_all_cells},
+    // averaged apart (sphere_results.cpp): unknown in runs resumed from older checkpoints
     {column_names::F_all_cells, &LiquidSample::F_all_cells},
 };
 
