@@ -10,6 +10,8 @@
 #include <map>
 #include <utility>
 
+#include "engine/result_names/result_names.hpp"
+
 namespace flocsim::db {
 
 double unix_now() {
@@ -21,9 +23,10 @@ namespace {
 
 constexpr int kBusyTimeoutMs = 60000;
 
-// Version 1 of the schema. Later versions append migrations below; a database
-// records its version in PRAGMA user_version.
-constexpr const char* kSchemaV1 = R"sql(
+// Version 1 of the schema (its tables; the view follows). Later versions
+// append migrations below; a database records its version in PRAGMA
+// user_version.
+constexpr const char* kSchemaV1Tables = R"sql(
 CREATE TABLE sweeps (
   id            INTEGER PRIMARY KEY,
   name          TEXT NOT NULL UNIQUE,
@@ -97,23 +100,26 @@ CREATE TABLE observables (
   error   REAL,
   PRIMARY KEY (run_id, name)
 );
-CREATE VIEW suspension_results AS
-SELECT r.run_id,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'U_over_Uinf') AS U_over_Uinf,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'U_over_Uinf') AS U_over_Uinf_error,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'F') AS F,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'F') AS F_error,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'Re') AS Re,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'Re') AS Re_error,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'Re_T') AS Re_T,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'Re_T') AS Re_T_error,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'C_sph') AS C_sph,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'C_sph') AS C_sph_error,
-  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = 'n_a_mean') AS n_a_mean,
-  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = 'n_a_mean') AS n_a_mean_error,
-  r.window_json, r.wall_s, r.mlups, r.steps
-FROM results r;
 )sql";
+
+// The suspension_results view of schema version 1: one row per result, the
+// mean and error of each summary observable as columns, named as result.json
+// names them (result_names::kSummaryObservables).
+std::string suspension_results_view() {
+  std::string sql = "CREATE VIEW suspension_results AS\nSELECT r.run_id,\n";
+  for (const std::string_view name : result_names::kSummaryObservables) {
+    const std::string n(name);
+    sql += "  (SELECT mean  FROM observables o WHERE o.run_id = r.run_id AND o.name = '" + n +
+           "') AS " + n + ",\n";
+    sql += "  (SELECT error FROM observables o WHERE o.run_id = r.run_id AND o.name = '" + n +
+           "') AS " + n + "_error,\n";
+  }
+  return sql + "  r.window_json, r.wall_s, r.mlups, r.steps\nFROM results r;\n";
+}
+
+std::string schema_v1() {
+  return kSchemaV1Tables + suspension_results_view();
+}
 
 }  // namespace
 
@@ -398,7 +404,7 @@ void ResultsDb::create_or_migrate() {
       any.step();
       if (any.i64(0) != 0)
         throw DbError(path_ + " is an SQLite file but not a flocsim results database");
-      exec(kSchemaV1);
+      exec(schema_v1().c_str());
     }
     exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
   });

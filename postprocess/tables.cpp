@@ -7,6 +7,7 @@
 
 #include "engine/input/input_reader.hpp"
 #include "engine/observables/reference_correlations.hpp"
+#include "engine/result_names/result_names.hpp"
 #include "orchestrator/sweep.hpp"
 
 namespace flocsim::postprocess {
@@ -79,10 +80,12 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
         const json res = json::parse(r.result_json, nullptr, false);
         if (res.is_object()) {
           const json& obs = res.value("observables", json::object());
-          for (const char* name : {"U_over_Uinf", "F", "Re", "Re_T", "C_sph", "n_a_mean"})
+          for (const std::string_view summary : result_names::kSummaryObservables) {
+            const std::string name(summary);
             if (obs.contains(name) && obs[name].is_object() &&
                 !obs[name].value("error_reliable", true))
               u.errors_reliable = false;
+          }
           for (const auto& n : res.value("not_stationary", json::array()))
             if (n.is_string()) u.not_stationary.push_back(n.get<std::string>());
           if (obs.contains("window") && obs["window"].is_object()) {

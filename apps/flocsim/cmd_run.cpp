@@ -2,11 +2,11 @@
 // One solver instance; also what the orchestrator's workers execute.
 // Exit codes: 0 completed, 1 failed, 2 input refused, 3 stopped by a signal
 // after writing a checkpoint (continue with --resume).
-#include <algorithm>
 #include <cstdio>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "engine/case/fluid_case.hpp"
+#include "engine/case/scene.hpp"
 #include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/process/stop_signal.hpp"
@@ -31,21 +31,12 @@ int run_command(const RunArguments& a) {
   bool fluid_scene = false;
   try {
     const nlohmann::json document = input::read_json_file(a.case_file);
-    const nlohmann::json* scene =
-        document.is_object() && document.contains("scene") ? &document["scene"] : nullptr;
-    fluid_scene = scene && scene->is_string() && scene->get<std::string>() == "fluid";
-    if (fluid_scene) {
+    // the scene decides which parser and which time loop take the case
+    fluid_scene = !cases::modules_of(cases::scene_of(document)).spheres;
+    if (fluid_scene)
       fluid_case = cases::parse_fluid_case(document);
-    } else {
+    else
       sphere_case = cases::parse_suspension_case(document);
-      const auto& runnable = run::runnable_sphere_scenes();
-      if (std::find(runnable.begin(), runnable.end(), sphere_case.scene) == runnable.end()) {
-        std::string list = "\"fluid\"";
-        for (const auto& r : runnable) list += ", \"" + r + "\"";
-        throw input::InputError("scene = \"" + sphere_case.scene + "\": this build runs scenes " +
-                                list);
-      }
-    }
   } catch (const input::InputError& e) {
     // file-level refusals (read_json_file) already start with the file's name
     const std::string what = e.what();

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "engine/case/case_support.hpp"
+#include "engine/case/scene.hpp"
 #include "engine/input/input_reader.hpp"
 
 namespace flocsim::cases {
@@ -45,7 +46,7 @@ double cell_noise(unsigned seed, long cell, int component) {
 FluidCase parse_fluid_case(const nlohmann::json& document) {
   FluidCase c;
   InputReader root(document, "");
-  root.choice("scene", {"fluid"});
+  root.choice("scene", {std::string(scene_name(Scene::fluid))});
   c.precision = root.choice("precision", {"double", "float"}, "double") == "float"
                     ? Precision::single_precision
                     : Precision::double_precision;
@@ -166,7 +167,7 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
 
 nlohmann::json FluidCase::to_json() const {
   nlohmann::json j;
-  j["scene"] = "fluid";
+  j["scene"] = std::string(scene_name(Scene::fluid));
   j["precision"] = precision == Precision::single_precision ? "float" : "double";
   auto& f = j["fluid"];
   f["size"] = {size.nx, size.ny, size.nz};

@@ -117,18 +117,18 @@ double schiller_naumann_drag_coefficient(double reynolds) {
 SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   SuspensionCase c;
   InputReader root(document, "");
-  c.scene = root.choice("scene", {"suspension", "fixed-array", "single-sphere", "granular"});
+  c.scene = scene_from_name(root.choice("scene", scene_names(/*with_spheres=*/true)));
   c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
   const Preset p = preset(c.fidelity);
   c.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
   c.seed =
       static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 
-  const bool single = c.scene == "single-sphere";
+  const bool single = c.scene == Scene::single_sphere;
   if (root.has("positions_from")) {
-    if (c.scene != "fixed-array")
-      throw InputError("positions_from: only for scene \"fixed-array\" (scene = \"" + c.scene +
-                       "\")");
+    if (c.scene != Scene::fixed_array)
+      throw InputError("positions_from: only for scene \"fixed-array\" (scene = \"" +
+                       std::string(scene_name(c.scene)) + "\")");
     if (root.has("phi"))
       throw InputError(
           "phi and positions_from: give one; with positions_from the snapshot sets N and phi");
@@ -239,7 +239,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
              : "raise numerics.U_inf to at least " +
                    format_value(nu_min * c.reynolds_inf / (2 * a)) + " or leave it out"));
 
-  if (c.scene != "granular" && !c.input_radius_given) {
+  if (modules_of(c.scene).liquid && !c.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one
     const auto& table = calibration::CalibrationTable::shipped();
@@ -268,7 +268,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                            "; `flocsim calibrate --viscosity` makes one for this viscosity");
   }
 
-  if (c.scene == "suspension" && c.lubrication_model == "calibrated") {
+  if (modules_of(c.scene).lubrication && c.lubrication_model == "calibrated") {
     const auto& pairs = calibration::PairResistanceTable::shipped();
     try {
       c.lubrication_lattice_share = pairs.lattice_share(a, c.viscosity, c.ib_scheme);
@@ -346,7 +346,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   const double bytes =
       static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
   const double available = physical_memory_bytes();
-  if (c.scene != "granular" && available > 0 && bytes > 0.8 * available)
+  if (modules_of(c.scene).liquid && available > 0 && bytes > 0.8 * available)
     throw InputError("L_over_a = " + format_value(c.length_over_a) +
                      ", a_over_dx = " + format_value(a) + ": the " + std::to_string(L) + " x " +
                      std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
@@ -357,13 +357,13 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
 
 nlohmann::json SuspensionCase::to_json() const {
   nlohmann::json j;
-  j["scene"] = scene;
+  j["scene"] = std::string(scene_name(scene));
   j["fidelity"] = fidelity;
   j["precision"] = single_precision ? "float" : "double";
   j["seed"] = seed;
   if (!positions_from.empty())
     j["positions_from"] = positions_from;
-  else if (scene != "single-sphere")
+  else if (scene != Scene::single_sphere)
     j["phi"] = phi;
   j["Re_inf"] = reynolds_inf;
   j["density_ratio"] = density_ratio;
@@ -378,7 +378,7 @@ nlohmann::json SuspensionCase::to_json() const {
   j["L_over_a"] = length_over_a;
   j["L_over_W"] = length_over_width;
   j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
-  if (scene != "granular")
+  if (modules_of(scene).liquid)
     j["numerics"]["immersed_boundary"] = {
         {"marker_spacing", ib_scheme.marker_spacing},
         {"sweeps", ib_scheme.sweeps},
@@ -399,10 +399,11 @@ nlohmann::json SuspensionCase::to_json() const {
 
 nlohmann::json SuspensionCase::derived_json() const {
   const std::string input_radius_from =
-      input_radius_given    ? std::string("numerics.input_radius")
-      : scene == "granular" ? std::string("unused (no liquid)")
-                            : "shipped calibration, interpolated in log nu (nearest entry nu = " +
-                                  format_value(calibration_viscosity) + ")";
+      input_radius_given ? std::string("numerics.input_radius")
+      : !modules_of(scene).liquid
+          ? std::string("unused (no liquid)")
+          : "shipped calibration, interpolated in log nu (nearest entry nu = " +
+                format_value(calibration_viscosity) + ")";
   return {{"box_cells", {box.nx, box.ny, box.nz}},
           {"sphere_count", sphere_count},
           {"phi_realised", phi_realised},

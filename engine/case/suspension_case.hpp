@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/case/scene.hpp"
 #include "engine/immersed_boundary/scheme.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 
@@ -36,7 +37,7 @@ inline constexpr double kDefaultSettlingVelocity = 0.02;
 double smallest_stable_viscosity(double radius_cells);
 
 struct SuspensionCase {
-  std::string scene = "suspension";
+  Scene scene = Scene::suspension;
   std::string fidelity = "standard";
   bool single_precision = false;
   std::uint64_t seed = 1;

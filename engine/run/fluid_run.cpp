@@ -2,36 +2,23 @@
 
 #include <omp.h>
 
-#include <chrono>
 #include <cmath>
-#include <ctime>
-#include <fstream>
-#include <limits>
 
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
-#include "engine/process/stop_signal.hpp"
 #include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
-
-#ifndef FLOCSIM_VERSION
-#define FLOCSIM_VERSION "0.1.0"
-#endif
+#include "engine/run/run_shell.hpp"
 
 namespace flocsim::run {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using lattice::FluidLattice;
 namespace fs = std::filesystem;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // Quantities fixed at the start of the run, kept in the checkpoint so that a
 // resumed run reports against the same reference.
@@ -120,18 +107,15 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
 
 template <class Real>
 RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
-  const StartMode start = prepare_output_directory(o.out_dir, o.resume, c.to_json());
-  RunLog log(o.out_dir / "run.log", o.quiet);
-  if (start == StartMode::already_completed) return completed_run(o.out_dir, log);
-  for (const auto& w : c.warnings) log.warning(w);
-  if (c.run.threads > 0) omp_set_num_threads(c.run.threads);
-  const Clock::time_point t_start = Clock::now();
+  RunShell shell(o, c.to_json(), c.warnings, c.run.threads);
+  if (shell.start() == StartMode::already_completed) return shell.already_completed();
+  RunLog& log = shell.log();
 
   FluidLattice<Real> fluid(c.size, c.relaxation);
   fluid.set_body_force(c.body_force);
   Baseline base;
-  const fs::path checkpoint = o.out_dir / "checkpoint.h5";
-  if (start == StartMode::from_checkpoint) {
+  const fs::path& checkpoint = shell.checkpoint_file();
+  if (shell.resuming()) {
     read_checkpoint(checkpoint, fluid, c, base);
     log.info("resumed from " + checkpoint.string() + " at step " +
              std::to_string(fluid.time_step()));
@@ -142,7 +126,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     base.momentum = fluid.total_momentum();
     base.amplitude = wave_amplitude(fluid, c);
   }
-  log.info(std::string("flocsim ") + FLOCSIM_VERSION + " fluid scene: " +
+  log.info(std::string("flocsim ") + kFlocsimVersion + " fluid scene: " +
            std::to_string(c.size.nx) + " x " + std::to_string(c.size.ny) + " x " +
            std::to_string(c.size.nz) + " cells, nu = " + std::to_string(c.relaxation.viscosity) +
            " (tau = " + std::to_string(c.relaxation.tau_plus()) + "), " +
@@ -152,67 +136,46 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
 
   ProgressReporter progress(log, o.out_dir / "progress.json", fluid.time_step(), c.run.steps,
                             c.size.cells(), c.run.progress_every_s);
-  double fluid_s = 0, output_s = 0, checkpoint_s = 0;
-  Clock::time_point last_checkpoint = Clock::now();
-  long last_good_checkpoint_step = start == StartMode::from_checkpoint ? fluid.time_step() : -1;
-  const long first_step = fluid.time_step();
+  TimedStages stages;
+  const auto fluid_stage = stages.declare("fluid");
+  const auto output_stage = stages.declare("output");
+  const auto checkpoint_stage = stages.declare("checkpoint");
+  shell.set_first_step(fluid.time_step());
   // A blow-up shows as a non-finite population, which makes the mass sum
   // non-finite; checking it every few steps costs about 1 % of the run.
   const long health_every = 100;
 
   while (fluid.time_step() < c.run.steps) {
-    const Clock::time_point t0 = Clock::now();
-    fluid.step();
-    fluid_s += seconds_since(t0);
+    stages.run(fluid_stage, [&] { fluid.step(); });
     const long t = fluid.time_step();
 
     if (t % health_every == 0 || t == c.run.steps) {
       const double mass = fluid.total_mass();
       if (!std::isfinite(mass)) {
-        return blown_up_run(log, "step " + std::to_string(t), "the liquid mass is no longer finite",
-                            last_good_checkpoint_step, checkpoint,
-                            "velocities beyond the Mach limit or a viscosity too small for the "
-                            "resolution");
+        return shell.blown_up("step " + std::to_string(t), "the liquid mass is no longer finite",
+                              "velocities beyond the Mach limit or a viscosity too small for the "
+                              "resolution");
       }
     }
     if (c.run.write_fields && c.run.fields_every > 0 && t % c.run.fields_every == 0 &&
-        t != c.run.steps) {
-      const Clock::time_point t1 = Clock::now();
-      write_fields(o.out_dir, fluid);
-      output_s += seconds_since(t1);
-    }
-    const bool stop_now = process::stop_requested() != 0 ||
-                          (o.stop_after_steps > 0 && t - first_step >= o.stop_after_steps);
-    const bool checkpoint_due = seconds_since(last_checkpoint) >= c.run.checkpoint_every_s ||
-                                (o.checkpoint_every_steps > 0 && t % o.checkpoint_every_steps == 0);
-    if ((stop_now || checkpoint_due) && t < c.run.steps) {
+        t != c.run.steps)
+      stages.run(output_stage, [&] { write_fields(o.out_dir, fluid); });
+    const bool stop_now = shell.stop_requested(t);
+    if ((stop_now || shell.checkpoint_due(t, c.run.checkpoint_every_s)) && t < c.run.steps) {
       // only a state that passed the health check is checkpointed
       if (!std::isfinite(fluid.total_mass())) continue;
-      const Clock::time_point t1 = Clock::now();
-      write_checkpoint(o.out_dir, fluid, c, base, base.wall_s + seconds_since(t_start));
-      checkpoint_s += seconds_since(t1);
-      last_checkpoint = Clock::now();
-      last_good_checkpoint_step = t;
-      if (stop_now) {
-        progress.finish(t);
-        log.info("stopped at step " + std::to_string(t) +
-                 (process::stop_requested()
-                      ? " by signal " + std::to_string(process::stop_requested())
-                      : std::string()) +
-                 "; checkpoint written, continue with --resume");
-        RunReport r;
-        r.outcome = RunOutcome::interrupted;
-        return r;
-      }
+      stages.run(checkpoint_stage, [&] {
+        write_checkpoint(o.out_dir, fluid, c, base, base.wall_s + shell.wall_s());
+      });
+      shell.checkpoint_written(t);
+      if (stop_now) return shell.interrupted(progress, t);
     }
     progress.update(t);
   }
   progress.finish(fluid.time_step());
 
   // ---- final state and result.json ------------------------------------------
-  const Clock::time_point t1 = Clock::now();
-  if (c.run.write_fields) write_fields(o.out_dir, fluid);
-  output_s += seconds_since(t1);
+  if (c.run.write_fields) stages.run(output_stage, [&] { write_fields(o.out_dir, fluid); });
 
   nlohmann::json obs;
   const double mass = fluid.total_mass();
@@ -250,47 +213,27 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     obs["decay_rate_analytic"] = analytic_rate;
     obs["viscosity_measured"] = c.relaxation.viscosity * measured_rate / analytic_rate;
   }
-  const double wall = seconds_since(t_start);
-  const long steps_here = fluid.time_step() - first_step;
+  const double wall = shell.wall_s();
+  const long steps_here = fluid.time_step() - shell.first_step();
+  const double fluid_s = stages.seconds(fluid_stage);
   nlohmann::json result;
-  result["status"] = "completed";
-  result["flocsim_version"] = FLOCSIM_VERSION;
   result["case"] = c.to_json();
   result["observables"] = obs;
-  result["cost"] = {
-      {"wall_s", base.wall_s + wall},
-      {"wall_s_this_invocation", wall},
-      {"steps", c.run.steps},
-      {"steps_this_invocation", steps_here},
-      {"threads", omp_get_max_threads()},
-      {"MLUPS", fluid_s > 0 ? steps_here * n / fluid_s / 1e6 : 0.0},
-      {"modules_s", {{"fluid", fluid_s}, {"output", output_s}, {"checkpoint", checkpoint_s}}}};
-  result["completed_at"] = utc_timestamp();
-  output::write_file_atomically(o.out_dir / "result.json", result.dump(2) + "\n");
-  // The result is complete on disk; the checkpoint is no longer needed.
-  std::error_code ec;
-  fs::remove(checkpoint, ec);
-  log.info("completed " + std::to_string(c.run.steps) + " steps in " + format_duration(wall) +
-           " (" + std::to_string(result["cost"]["MLUPS"].get<double>()) + " MLUPS); result in " +
-           (o.out_dir / "result.json").string());
-  RunReport r;
-  r.outcome = RunOutcome::completed;
-  r.result = std::move(result);
-  return r;
+  result["cost"] = shell.cost(base.wall_s, wall, c.run.steps, steps_here, stages);
+  result["cost"]["MLUPS"] = fluid_s > 0 ? steps_here * n / fluid_s / 1e6 : 0.0;
+  const std::string mlups = std::to_string(result["cost"]["MLUPS"].get<double>());
+  return shell.complete(std::move(result), wall, std::to_string(c.run.steps) + " steps",
+                        " (" + mlups + " MLUPS)");
 }
 
 }  // namespace
 
 RunReport run_fluid_case(const cases::FluidCase& c, const RunOptions& options) {
-  try {
+  return run_guarded(options.out_dir, [&] {
     return c.precision == cases::Precision::single_precision
                ? run_with_precision<float>(c, options)
                : run_with_precision<double>(c, options);
-  } catch (const input::InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    return failed_run(options.out_dir, e);  // I/O (a full disk) or another module's failure
-  }
+  });
 }
 
 }  // namespace flocsim::run

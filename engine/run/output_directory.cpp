@@ -4,6 +4,7 @@
 #include <ctime>
 #include <fstream>
 
+#include "engine/case/scene.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 
@@ -173,7 +174,8 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
       for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
         c[group].erase(key);
     }
-    if (c.value("scene", "") == "fluid" && c.contains("run")) c["run"].erase("steps");
+    if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
+      c["run"].erase("steps");
     return c;
   };
   return physics_only(checkpoint_case) == physics_only(current_case);

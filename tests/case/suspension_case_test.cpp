@@ -129,7 +129,10 @@ TEST(SuspensionCase, BadInputsAreNamed) {
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("Re: unknown key"), HasSubstr("Re_inf")));
   d = base;
   d["scene"] = "fluidised-bed";
-  EXPECT_THAT(refusal(d), AllOf(HasSubstr("scene"), HasSubstr("\"suspension\"")));
+  EXPECT_THAT(refusal(d), AllOf(HasSubstr("scene = \"fluidised-bed\""), HasSubstr("\"suspension\""),
+                                HasSubstr("\"granular\"")));
+  d["scene"] = "fluid";  // a scene, but not one with spheres
+  EXPECT_THAT(refusal(d), AllOf(HasSubstr("scene = \"fluid\""), HasSubstr("\"fixed-array\"")));
   d = base;
   d["density_ratio"] = 0.5;
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("density_ratio = 0.5"), HasSubstr("settle")));

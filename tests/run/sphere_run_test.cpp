@@ -2,7 +2,7 @@
 // interactions and no liquid): a run stopped and resumed gives bit-identical
 // results; elastic hard spheres with square wells conserve kinetic energy
 // minus the well depth of attached pairs; the protocol's stages and windows
-// are reported; unknown scenes are refused as input errors.
+// are reported; scenes without spheres are refused as input errors.
 #include "engine/run/sphere_run.hpp"
 
 #include <gtest/gtest.h>
@@ -113,9 +113,9 @@ TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
   fs::remove_all(dir);
 }
 
-TEST(SphereRun, UnknownScenesAreInputErrors) {
+TEST(SphereRun, ScenesWithoutSpheresAreInputErrors) {
   cases::SuspensionCase c = granular(0.0);
-  c.scene = "sedimenting-bed";  // a case built in code, past the parser's check
+  c.scene = cases::Scene::fluid;  // a case built in code, past the parser's check
   EXPECT_THROW(run_sphere_case(c, {fresh_dir("refused"), false, true, 0}), input::InputError);
 }
 

@@ -1,0 +1,150 @@
+#pragma once
+// One time step of a sphere scene: the modules the scene composes
+// (cases::SceneModules), each a named stage timed by name, in this order:
+//
+//   immersed_boundary  no-slip forces from the current sphere state, spread
+//                      onto the lattice
+//   fluid              collision and streaming with those forces
+//   spheres            velocities from the hydrodynamic force and torque, net
+//                      gravity and the inside-liquid momentum change
+//   (health)           every sphere's speed, before anything moves them
+//   lubrication        radial lubrication below s0, implicit per pair
+//   events             collisions and square wells while the spheres move to
+//                      the end of the step; without contacts a ballistic move
+//                      (timed as spheres)
+//
+// The liquid is driven by the body force f that balances the net gravity of
+// the spheres (docs/model.md section 1), so the total momentum stays zero.
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/case/suspension_case.hpp"
+#include "engine/events/direct_interactions.hpp"
+#include "engine/immersed_boundary/immersed_boundary.hpp"
+#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lubrication/radial_lubrication.hpp"
+#include "engine/run/timed_stages.hpp"
+#include "engine/spheres/sphere_dynamics.hpp"
+
+namespace flocsim::run {
+
+// Stage names, as result.json's cost.modules_s reports them.
+namespace stage_name {
+inline constexpr std::string_view immersed_boundary = "immersed_boundary";
+inline constexpr std::string_view fluid = "fluid";
+inline constexpr std::string_view spheres = "spheres";
+inline constexpr std::string_view lubrication = "lubrication";
+inline constexpr std::string_view events = "events";
+}  // namespace stage_name
+
+// The liquid and its coupling to the spheres (scenes with a liquid).
+template <class Real>
+struct Liquid {
+  lattice::FluidLattice<Real> fluid;
+  immersed_boundary::ImmersedBoundary<Real> ib;
+  spheres::SphereDynamicsSettings dynamics;
+  std::vector<std::uint8_t> solid;  // scratch of the liquid averages
+
+  explicit Liquid(const cases::SuspensionCase& c)
+      : fluid(c.box, {c.viscosity, c.trt_magic}), ib({c.input_radius, c.ib_scheme, false}) {
+    const double volume = static_cast<double>(c.box.cells());
+    dynamics.external =
+        spheres::settling_forces(static_cast<std::size_t>(c.sphere_count), c.radius_cells,
+                                 c.density_ratio, volume, c.gravity);
+    fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
+    fluid.enable_force_field();
+  }
+};
+
+// Fastest sphere speed accepted before the run is called unstable: beyond
+// 0.3 (Ma ~ 0.5) the lattice cannot carry the flow around it.
+inline constexpr double kMaxSphereSpeed = 0.3;
+
+// Empty when every sphere's speed is finite and below kMaxSphereSpeed, else
+// what went wrong.
+std::string sphere_health(const spheres::SphereSet& s);
+
+template <class Real>
+class CoupledStep {
+ public:
+  // `escape_velocity`: the square well's strength at the start (the protocol's).
+  CoupledStep(const cases::SuspensionCase& c, double escape_velocity, TimedStages& stages)
+      : modules_(cases::modules_of(c.scene)),
+        box_{spheres::Vec3(c.box.nx, c.box.ny, c.box.nz)},
+        contacts_({.restitution = c.restitution,
+                   .friction = c.friction,
+                   .escape_velocity = escape_velocity,
+                   .well_width = c.well_width}),
+        lubrication_({.viscosity = c.viscosity,
+                      .liquid_density = 1.0,
+                      .onset_gap = c.lubrication_onset_over_a,
+                      .saturation_gap = c.lubrication_saturation_over_a,
+                      .lattice_share = c.lubrication_lattice_share,
+                      .explicit_euler = c.lubrication_integration == "explicit-paper"}),
+        stages_(stages) {
+    // The stages a scene reports: those of the liquid's coupling wherever
+    // there is a liquid, events always (0 s without contacts).
+    if (modules_.liquid) {
+      liquid_ = std::make_unique<Liquid<Real>>(c);
+      ib_stage_ = stages.declare(stage_name::immersed_boundary);
+      fluid_stage_ = stages.declare(stage_name::fluid);
+      lubrication_stage_ = stages.declare(stage_name::lubrication);
+    }
+    if (modules_.liquid || (modules_.spheres_move && !modules_.contacts))
+      spheres_stage_ = stages.declare(stage_name::spheres);
+    events_stage_ = stages.declare(stage_name::events);
+  }
+
+  // Advances `s` by one time step. Returns what went wrong when a sphere ran
+  // away (a blow-up starts within a few steps): a diagnosed failure with the
+  // last good checkpoint kept, not an event engine asked for an impossible
+  // pair search. Empty when healthy.
+  std::string advance(spheres::SphereSet& s) {
+    if (liquid_) {
+      Liquid<Real>& l = *liquid_;
+      stages_.run(ib_stage_, [&] { l.ib.apply(l.fluid, s); });
+      stages_.run(fluid_stage_, [&] { l.fluid.step(); });
+      stages_.run(spheres_stage_, [&] {
+        if (modules_.spheres_move)
+          spheres::advance_velocities(s,
+                                      {l.ib.force(), l.ib.torque(), l.ib.internal_momentum_change(),
+                                       l.ib.internal_angular_momentum_change()},
+                                      l.dynamics);
+      });
+    }
+    // O(N), well under 1 % of a step
+    if (modules_.spheres_move) {
+      std::string sick = sphere_health(s);
+      if (!sick.empty()) return sick;
+    }
+    if (modules_.lubrication)
+      stages_.run(lubrication_stage_, [&] { lubrication_.apply(s, box_, 1.0); });
+    if (modules_.contacts)
+      stages_.run(events_stage_, [&] { contacts_.advance(s, box_, 1.0); });
+    else if (modules_.spheres_move)
+      stages_.run(spheres_stage_, [&] { spheres::advance_positions(s, box_); });
+    return {};
+  }
+
+  const cases::SceneModules& modules() const { return modules_; }
+  const spheres::PeriodicBox& box() const { return box_; }
+  events::DirectInteractions& contacts() { return contacts_; }
+  const events::DirectInteractions& contacts() const { return contacts_; }
+  Liquid<Real>* liquid() { return liquid_.get(); }
+  const Liquid<Real>* liquid() const { return liquid_.get(); }
+
+ private:
+  cases::SceneModules modules_;
+  spheres::PeriodicBox box_;
+  events::DirectInteractions contacts_;
+  const lubrication::RadialLubrication lubrication_;
+  std::unique_ptr<Liquid<Real>> liquid_;
+  TimedStages& stages_;
+  TimedStages::Id ib_stage_ = 0, fluid_stage_ = 0, spheres_stage_ = 0, lubrication_stage_ = 0,
+                  events_stage_ = 0;
+};
+
+}  // namespace flocsim::run

@@ -1,0 +1,104 @@
+#include "engine/run/protocol.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/observables/suspension_averages.hpp"
+#include "engine/result_names/result_names.hpp"
+
+namespace flocsim::run {
+
+namespace {
+
+Protocol::Durations durations_of(const cases::SuspensionCase& c) {
+  const double T = c.convective_time;
+  auto steps = [T](double in_convective_times) {
+    return static_cast<long>(std::llround(in_convective_times * T));
+  };
+  Protocol::Durations d;
+  d.sample = std::max(1L, steps(c.sample_every));
+  d.stage1_min = steps(c.stage1_min);
+  d.stage1_max = steps(c.stage1_max);
+  d.settle = steps(c.stage2_settle);
+  d.statistics = std::max(d.sample, steps(c.statistics));
+  d.snapshot = c.snapshot_every > 0 ? std::max(1L, steps(c.snapshot_every)) : 0;
+  d.window_samples =
+      std::max(5L, static_cast<long>(std::llround(c.stationarity_window / c.sample_every)));
+  return d;
+}
+
+}  // namespace
+
+Protocol::Protocol(const cases::SuspensionCase& c, const cases::SceneModules& modules)
+    : d_(durations_of(c)),
+      signal_(modules.liquid ? result_names::column::U_over_Uinf
+                             : result_names::column::granular_temperature),
+      convective_time_(c.convective_time),
+      du_over_uinf_(c.du_over_uinf),
+      target_escape_velocity_(c.escape_velocity),
+      // stage 2 exists only where a square well acts
+      has_stage2_(modules.contacts && c.escape_velocity > 0) {}
+
+bool Protocol::done(long step) const {
+  return statistics_start_ >= 0 && step - statistics_start_ >= d_.statistics;
+}
+
+long Protocol::expected_total(long step) const {
+  const long after_stage1 = has_stage2_ ? d_.settle + d_.statistics : d_.statistics;
+  if (stage_ == 1 && statistics_start_ < 0) return std::max(step, d_.stage1_max) + after_stage1;
+  if (statistics_start_ >= 0) return statistics_start_ + d_.statistics;
+  return stage2_start_ + d_.settle + d_.statistics;
+}
+
+std::string Protocol::phase() const {
+  return statistics_start_ >= 0 ? "statistics" : stage_ == 2 ? "stage 2" : "stage 1";
+}
+
+bool Protocol::advance(long step, const std::vector<double>& signal,
+                       events::DirectInteractions& contacts, const spheres::SphereSet& spheres,
+                       const spheres::PeriodicBox& box, RunLog& log) {
+  if (stage_ == 1 && statistics_start_ < 0 && step >= d_.stage1_min) {
+    const bool stationary = observables::is_stationary(signal, d_.window_samples);
+    if (!stationary && step < d_.stage1_max) return false;
+    stage1_stationary_ = stationary;
+    const std::string why =
+        stationary ? " (stationary)" : " (stage1_max reached before the detector fired)";
+    if (has_stage2_) {
+      stage_ = 2;
+      stage2_start_ = step;
+      contacts.set_escape_velocity(target_escape_velocity_);
+      contacts.attach_pairs_within_well(spheres, box);
+      log.info("stage 2 at t U_inf/a = " + std::to_string(step / convective_time_) + why +
+               ": du/U_inf = " + std::to_string(du_over_uinf_));
+    } else {
+      statistics_start_ = step;
+      log.info("statistics from t U_inf/a = " + std::to_string(step / convective_time_) + why);
+    }
+    return true;
+  }
+  if (stage_ == 2 && statistics_start_ < 0 && step - stage2_start_ >= d_.settle) {
+    statistics_start_ = step;
+    log.info("statistics from t U_inf/a = " + std::to_string(step / convective_time_));
+  }
+  return false;
+}
+
+void Protocol::write(output::Hdf5File& f) const {
+  f.set_attribute("/", "stage", static_cast<std::int64_t>(stage_));
+  f.set_attribute("/", "stage2_start", static_cast<std::int64_t>(stage2_start_));
+  f.set_attribute("/", "statistics_start", static_cast<std::int64_t>(statistics_start_));
+  f.set_attribute("/", "stage1_stationary", static_cast<std::int64_t>(stage1_stationary_));
+}
+
+void Protocol::read(const output::Hdf5File& f) {
+  stage_ = static_cast<int>(f.attribute_int("/", "stage"));
+  stage2_start_ = f.attribute_int("/", "stage2_start");
+  statistics_start_ = f.attribute_int("/", "statistics_start");
+  stage1_stationary_ = f.attribute_int("/", "stage1_stationary") != 0;
+}
+
+void Protocol::restore_well(events::DirectInteractions& contacts) const {
+  if (stage_ == 2) contacts.set_escape_velocity(target_escape_velocity_);
+}
+
+}  // namespace flocsim::run

@@ -1,0 +1,104 @@
+#include "engine/run/run_shell.hpp"
+
+#include <omp.h>
+
+#include "engine/output/atomic_file.hpp"
+#include "engine/process/stop_signal.hpp"
+
+// The library is built without the application's definition; the project's
+// version is the same string.
+#ifndef FLOCSIM_VERSION
+#define FLOCSIM_VERSION "0.1.0"
+#endif
+
+namespace flocsim::run {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+const char* const kFlocsimVersion = FLOCSIM_VERSION;
+
+RunShell::RunShell(const RunOptions& options, const nlohmann::json& case_json,
+                   const std::vector<std::string>& warnings, int threads)
+    : options_(options),
+      start_(prepare_output_directory(options.out_dir, options.resume, case_json)),
+      log_(options.out_dir / "run.log", options.quiet),
+      checkpoint_(options.out_dir / "checkpoint.h5") {
+  if (start_ != StartMode::already_completed) {
+    for (const auto& w : warnings) log_.warning(w);
+    if (threads > 0) omp_set_num_threads(threads);
+  }
+  t_start_ = Clock::now();
+  last_checkpoint_ = t_start_;
+}
+
+RunReport RunShell::already_completed() {
+  return completed_run(options_.out_dir, log_);
+}
+
+void RunShell::set_first_step(long step) {
+  first_step_ = step;
+  last_good_checkpoint_ = resuming() ? step : -1;
+  last_checkpoint_ = Clock::now();
+}
+
+bool RunShell::stop_requested(long step) const {
+  return process::stop_requested() != 0 ||
+         (options_.stop_after_steps > 0 && step - first_step_ >= options_.stop_after_steps);
+}
+
+bool RunShell::checkpoint_due(long step, double every_s) const {
+  return TimedStages::since(last_checkpoint_) >= every_s ||
+         (options_.checkpoint_every_steps > 0 && step % options_.checkpoint_every_steps == 0);
+}
+
+void RunShell::checkpoint_written(long step) {
+  last_checkpoint_ = Clock::now();
+  last_good_checkpoint_ = step;
+}
+
+RunReport RunShell::interrupted(ProgressReporter& progress, long step) {
+  progress.finish(step);
+  log_.info("stopped at step " + std::to_string(step) +
+            (process::stop_requested() ? " by signal " + std::to_string(process::stop_requested())
+                                       : std::string()) +
+            "; checkpoint written, continue with --resume");
+  RunReport r;
+  r.outcome = RunOutcome::interrupted;
+  return r;
+}
+
+RunReport RunShell::blown_up(const std::string& where, const std::string& what,
+                             const std::string& likely_causes) {
+  return blown_up_run(log_, where, what, last_good_checkpoint_, checkpoint_, likely_causes);
+}
+
+nlohmann::json RunShell::cost(double wall_before_s, double wall_s, long steps,
+                              long steps_this_invocation, const TimedStages& stages) const {
+  return {{"wall_s", wall_before_s + wall_s},
+          {"wall_s_this_invocation", wall_s},
+          {"steps", steps},
+          {"steps_this_invocation", steps_this_invocation},
+          {"threads", omp_get_max_threads()},
+          {"modules_s", stages.seconds_by_name()}};
+}
+
+RunReport RunShell::complete(nlohmann::json result, double wall_s, const std::string& what,
+                             const std::string& rate) {
+  result["status"] = "completed";
+  result["flocsim_version"] = kFlocsimVersion;
+  result["completed_at"] = utc_timestamp();
+  const fs::path file = options_.out_dir / "result.json";
+  output::write_file_atomically(file, result.dump(2) + "\n");
+  // The result is complete on disk; the checkpoint is no longer needed.
+  std::error_code ec;
+  fs::remove(checkpoint_, ec);
+  log_.info("completed " + what + " in " + format_duration(wall_s) + rate + "; result in " +
+            file.string());
+  RunReport r;
+  r.outcome = RunOutcome::completed;
+  r.result = std::move(result);
+  return r;
+}
+
+}  // namespace flocsim::run
