@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -325,16 +326,15 @@ TEST(StaticRandomArray, BeetstraPhi020Re40) {
 }
 
 // ---- the offered immersed-boundary options ------------------------------------
-// Every scheme the shipped calibration holds at a = 6 besides the paper's is
-// checked exactly as the paper's scheme is above (same references, same
-// tolerances), and its drag on a frozen random array is compared with the
-// paper scheme's on the identical configuration: that difference is what a
-// user buys by choosing the option (docs/accuracy-cost.md).
+// Every scheme the shipped calibration holds at a = 6, the paper's included,
+// is checked on the same references with the same tolerances, and the drag of
+// each other option on a frozen random array is compared with the paper
+// scheme's on the identical configuration: that difference is what a user
+// buys by choosing the option (docs/accuracy-cost.md).
 std::vector<immersed_boundary::Scheme> offered_options() {
   std::vector<immersed_boundary::Scheme> out;
   for (const auto& e : calibration::CalibrationTable::shipped().entries()) {
-    if (std::abs(e.hydrodynamic_radius - 6.0) > 1e-6 || e.scheme == immersed_boundary::kPaperScheme)
-      continue;
+    if (std::abs(e.hydrodynamic_radius - 6.0) > 1e-6) continue;
     bool seen = false;
     for (const auto& o : out) seen = seen || o == e.scheme;
     if (!seen) out.push_back(e.scheme);
@@ -344,12 +344,14 @@ std::vector<immersed_boundary::Scheme> offered_options() {
 
 class IbOption : public ::testing::TestWithParam<immersed_boundary::Scheme> {};
 
-// Sangani & Acrivos over phi = 0.01 - 0.27 at a = 4 and 6, 0.05 - 0.27 at a = 8
-// (box sizes the calibration did not use): within 2 %, as the paper scheme.
+// Sangani & Acrivos over phi = 0.01 - 0.27 at a = 6, 0.05 - 0.27 at a = 8
+// (0.01 would need a 60^3 box) and 0.01 - 0.2 at a = 4 (at 0.27 the cube,
+// 10 dx, is narrower than a sphere's kernel cells and their periodic image
+// allow): box sizes the calibration did not use, within 2 %.
 TEST_P(IbOption, SimpleCubicArraysMatchSanganiAcrivos) {
   for (double a : {4.0, 6.0, 8.0})
     for (double phi : {0.01, 0.05, 0.1, 0.2, 0.27}) {
-      if (a == 8.0 && phi == 0.01) continue;
+      if ((a == 8.0 && phi == 0.01) || (a == 4.0 && phi == 0.27)) continue;
       EXPECT_LT(std::abs(array_error(a, phi, GetParam())), 0.02) << "a " << a << ", phi " << phi;
     }
 }
@@ -364,8 +366,13 @@ TEST_P(IbOption, SettlingSphereMatchesSchillerNaumannAtRe12) {
 // and 6: within 15 % of Beetstra as above, and the drag's difference from
 // the paper scheme on the same configuration printed for the table.
 TEST_P(IbOption, StaticRandomArrayAgainstBeetstraAndThePaperScheme) {
+  if (GetParam() == immersed_boundary::kPaperScheme)
+    GTEST_SKIP() << "the paper scheme's own arrays: StaticRandomArray.*";
+  static std::map<double, double> paper_drag;  // a -> F with the paper scheme, once per process
   for (double a : {4.0, 6.0}) {
-    const double paper = static_random_array(0.20, 10, 0.02, immersed_boundary::kPaperScheme, a);
+    if (!paper_drag.count(a))
+      paper_drag[a] = static_random_array(0.20, 10, 0.02, immersed_boundary::kPaperScheme, a);
+    const double paper = paper_drag[a];
     const double option = static_random_array(0.20, 10, 0.02, GetParam(), a);
     std::printf("a = %g: F(%s) / F(paper scheme) - 1 = %+.2f %%\n", a,
                 GetParam().describe().c_str(), 100 * (option / paper - 1));
