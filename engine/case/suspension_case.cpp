@@ -120,7 +120,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.scene = scene_from_name(root.choice("scene", scene_names(/*with_spheres=*/true)));
   c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
   const Preset p = preset(c.fidelity);
-  c.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
+  c.numerics.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
   c.seed =
       static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 
@@ -138,60 +138,64 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
           "positions_from = \"\": must name a sphere snapshot file (spheres/step_N.h5 of a run)");
   }
   if (!single && c.positions_from.empty())
-    c.phi = root.number("phi",
-                        {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
-  c.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
-  c.density_ratio = root.number("density_ratio",
-                                {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
-  c.du_over_uinf = root.number("du_over_Uinf", {.at_least = 0, .at_most = 0.5}, 0.0);
-  c.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
-  c.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
-  c.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
-  c.lubrication_model =
+    c.physics.phi = root.number(
+        "phi", {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
+  c.physics.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
+  c.physics.density_ratio = root.number(
+      "density_ratio", {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
+  c.physics.du_over_uinf = root.number("du_over_Uinf", {.at_least = 0, .at_most = 0.5}, 0.0);
+  c.physics.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
+  c.physics.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
+  c.physics.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
+  c.physics.lubrication_model =
       root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "nguyen-ladd");
-  c.lubrication_integration =
+  c.physics.lubrication_integration =
       root.choice("lubrication_integration", {"implicit", "explicit-paper"}, "implicit");
-  c.lubrication_onset_over_a =
+  c.physics.lubrication_onset_over_a =
       root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
-  c.lubrication_saturation_over_a = root.number(
-      "lubrication_saturation_over_a",
-      {.above = 0, .below = c.lubrication_onset_over_a, .why = "(below lubrication_onset_over_a)"},
-      2e-4);
-  c.length_over_a = root.number("L_over_a", {.at_least = 8, .at_most = 256}, p.length_over_a);
-  c.length_over_width = root.number("L_over_W", {.at_least = 0.25, .at_most = 8}, 2.0);
+  c.physics.lubrication_saturation_over_a =
+      root.number("lubrication_saturation_over_a",
+                  {.above = 0,
+                   .below = c.physics.lubrication_onset_over_a,
+                   .why = "(below lubrication_onset_over_a)"},
+                  2e-4);
+  c.physics.length_over_a =
+      root.number("L_over_a", {.at_least = 8, .at_most = 256}, p.length_over_a);
+  c.physics.length_over_width = root.number("L_over_W", {.at_least = 0.25, .at_most = 8}, 2.0);
 
   InputReader num = root.object("numerics");
-  c.radius_cells = num.number("a_over_dx", {.at_least = 3, .at_most = 24}, p.radius_cells);
+  c.numerics.radius_cells = num.number("a_over_dx", {.at_least = 3, .at_most = 24}, p.radius_cells);
   const bool has_nu = num.has("viscosity"), has_u = num.has("U_inf");
   if (has_nu && has_u)
     throw InputError(
         "numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the "
         "other through Re_inf)");
-  const double a = c.radius_cells;
+  const double a = c.numerics.radius_cells;
   const double nu_min = smallest_stable_viscosity(a);
   const std::string stable_why =
       "(the smallest viscosity the coupled solver is measured stable at "
       "with a_over_dx = " +
       format_value(a) + "; docs/numerics.md)";
   if (has_nu) {
-    c.viscosity = num.number("viscosity", {.at_least = nu_min, .at_most = 1, .why = stable_why});
-    c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
+    c.numerics.viscosity =
+        num.number("viscosity", {.at_least = nu_min, .at_most = 1, .why = stable_why});
+    c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
   } else {
     const Range u_range{
         .above = 0, .at_most = kMaxSettlingVelocity, .why = "(Mach limit for settling flows)"};
-    c.settling_velocity = num.number("U_inf", u_range, kDefaultSettlingVelocity);
-    c.viscosity = c.settling_velocity * 2 * a / c.reynolds_inf;
+    c.derived.settling_velocity = num.number("U_inf", u_range, kDefaultSettlingVelocity);
+    c.numerics.viscosity = c.derived.settling_velocity * 2 * a / c.physics.reynolds_inf;
     // by default stay inside the stable viscosity range: raise U_inf instead
-    if (!has_u && c.viscosity < nu_min) {
-      c.viscosity = nu_min;
-      c.settling_velocity = c.reynolds_inf * c.viscosity / (2 * a);
+    if (!has_u && c.numerics.viscosity < nu_min) {
+      c.numerics.viscosity = nu_min;
+      c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
     }
   }
-  c.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
-  c.ib_scheme = read_ib_scheme(num, p.ib_scheme);
-  c.input_radius_given = num.has("input_radius");
-  if (c.input_radius_given)
-    c.input_radius = num.number(
+  c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
+  c.numerics.ib_scheme = read_ib_scheme(num, p.ib_scheme);
+  c.numerics.input_radius_given = num.has("input_radius");
+  if (c.numerics.input_radius_given)
+    c.numerics.input_radius = num.number(
         "input_radius",
         {.at_least = a - 1,
          .at_most = a,
@@ -206,7 +210,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
       if (calibrated > a &&
           2 * calibrated * kMaxSettlingVelocity / smallest_stable_viscosity(calibrated) >=
-              c.reynolds_inf) {
+              c.physics.reynolds_inf) {
         needed = calibrated;
         break;
       }
@@ -217,66 +221,68 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
            "; raise numerics.a_over_dx to at least " + format_value(needed) +
            (a < 6 && needed <= 6 ? " (fidelity standard or paper)" : "") + " or lower Re_inf";
   };
-  if (c.settling_velocity > kMaxSettlingVelocity) {
+  if (c.derived.settling_velocity > kMaxSettlingVelocity) {
     const std::string way_out =
-        c.viscosity <= nu_min ? beyond_reach() : std::string("lower numerics.viscosity");
-    throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.reynolds_inf) +
-                     " * " + format_value(c.viscosity) + " / " + format_value(2 * a) + " = " +
-                     format_value(c.settling_velocity) +
-                     ": must be <= " + format_value(kMaxSettlingVelocity) +
-                     " (Mach limit for settling flows); " + way_out);
+        c.numerics.viscosity <= nu_min ? beyond_reach() : std::string("lower numerics.viscosity");
+    throw InputError(
+        "numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.physics.reynolds_inf) + " * " +
+        format_value(c.numerics.viscosity) + " / " + format_value(2 * a) + " = " +
+        format_value(c.derived.settling_velocity) + ": must be <= " +
+        format_value(kMaxSettlingVelocity) + " (Mach limit for settling flows); " + way_out);
   }
   // Only reachable through an explicit U_inf: a given viscosity is range-checked
   // above and the default U_inf is raised to stay inside the range.
-  if (c.viscosity < nu_min)
+  if (c.numerics.viscosity < nu_min)
     throw InputError(
-        "numerics.U_inf = " + format_value(c.settling_velocity) +
-        " with Re_inf = " + format_value(c.reynolds_inf) + " and a_over_dx = " + format_value(a) +
-        " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.viscosity) +
+        "numerics.U_inf = " + format_value(c.derived.settling_velocity) + " with Re_inf = " +
+        format_value(c.physics.reynolds_inf) + " and a_over_dx = " + format_value(a) +
+        " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.numerics.viscosity) +
         ": must be >= " + format_value(nu_min) + " " + stable_why + "; " +
-        (c.reynolds_inf > largest_re
+        (c.physics.reynolds_inf > largest_re
              ? beyond_reach()
              : "raise numerics.U_inf to at least " +
-                   format_value(nu_min * c.reynolds_inf / (2 * a)) + " or leave it out"));
+                   format_value(nu_min * c.physics.reynolds_inf / (2 * a)) + " or leave it out"));
 
-  if (modules_of(c.scene).liquid && !c.input_radius_given) {
+  if (modules_of(c.scene).liquid && !c.numerics.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one
     const auto& table = calibration::CalibrationTable::shipped();
-    if (table.has(a, immersed_boundary::kPaperScheme) && !table.has(a, c.ib_scheme))
+    if (table.has(a, immersed_boundary::kPaperScheme) && !table.has(a, c.numerics.ib_scheme))
       throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.ib_scheme) +
+          "numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) +
           ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
-          c.ib_scheme.describe() + "); calibrate it with `flocsim calibrate --radius " +
+          c.numerics.ib_scheme.describe() + "); calibrate it with `flocsim calibrate --radius " +
           format_value(a) + " --viscosity NU --marker-spacing " +
-          format_value(c.ib_scheme.marker_spacing) + " --sweeps " +
-          std::to_string(c.ib_scheme.sweeps) + " --kernel " +
-          immersed_boundary::kernel_name(c.ib_scheme.kernel) +
+          format_value(c.numerics.ib_scheme.marker_spacing) + " --sweeps " +
+          std::to_string(c.numerics.ib_scheme.sweeps) + " --kernel " +
+          immersed_boundary::kernel_name(c.numerics.ib_scheme.kernel) +
           " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
           "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
     try {
-      c.input_radius = table.input_radius(a, c.viscosity, c.ib_scheme);
-      c.calibration_viscosity = table.lookup(a, c.viscosity, c.ib_scheme).viscosity;
+      c.numerics.input_radius = table.input_radius(a, c.numerics.viscosity, c.numerics.ib_scheme);
+      c.numerics.calibration_viscosity =
+          table.lookup(a, c.numerics.viscosity, c.numerics.ib_scheme).viscosity;
     } catch (const std::out_of_range& e) {
       throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
                        " Or give numerics.input_radius (the marker radius a_g) yourself.");
     }
-    if (std::abs(std::log(c.calibration_viscosity / c.viscosity)) > std::log(2.0))
+    if (std::abs(std::log(c.numerics.calibration_viscosity / c.numerics.viscosity)) > std::log(2.0))
       c.warnings.push_back("the hydrodynamic-radius calibration nearest to viscosity = " +
-                           format_value(c.viscosity) + " was made at " +
-                           format_value(c.calibration_viscosity) +
+                           format_value(c.numerics.viscosity) + " was made at " +
+                           format_value(c.numerics.calibration_viscosity) +
                            "; `flocsim calibrate --viscosity` makes one for this viscosity");
   }
 
-  if (modules_of(c.scene).lubrication && c.lubrication_model == "calibrated") {
+  if (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated") {
     const auto& pairs = calibration::PairResistanceTable::shipped();
     try {
-      c.lubrication_lattice_share = pairs.lattice_share(a, c.viscosity, c.ib_scheme);
+      c.numerics.lubrication_lattice_share =
+          pairs.lattice_share(a, c.numerics.viscosity, c.numerics.ib_scheme);
     } catch (const std::out_of_range& e) {
       throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
                        format_value(a) + ": " + e.what());
     }
-    if (c.input_radius_given)
+    if (c.numerics.input_radius_given)
       c.warnings.push_back(
           "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +
           format_value(a) + "; with numerics.input_radius given it holds only approximately");
@@ -284,70 +290,74 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
 
   InputReader pr = root.object("protocol");
   const Range duration{.at_least = 0, .at_most = 1e5};
-  c.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
-  c.stage1_max =
-      pr.number("stage1_max",
-                {.at_least = c.stage1_min, .at_most = 1e5, .why = "(at least protocol.stage1_min)"},
-                p.stage1_max);
-  c.stage2_settle = pr.number("stage2_settle", duration, p.stage2_settle);
-  c.statistics = pr.number("statistics", {.above = 0, .at_most = 1e5}, p.statistics);
-  c.sample_every = pr.number("sample_every", {.above = 0, .at_most = 100}, 0.5);
-  c.stationarity_window = pr.number("stationarity_window", {.above = 0, .at_most = 1e4}, 20.0);
-  c.snapshot_every = pr.number("snapshot_every", duration, 10.0);
-  c.checkpoint_every_s = pr.number("checkpoint_every_s", {.above = 0}, 600.0);
-  c.progress_every_s = pr.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
-  c.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
+  c.protocol.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
+  c.protocol.stage1_max = pr.number(
+      "stage1_max",
+      {.at_least = c.protocol.stage1_min, .at_most = 1e5, .why = "(at least protocol.stage1_min)"},
+      p.stage1_max);
+  c.protocol.stage2_settle = pr.number("stage2_settle", duration, p.stage2_settle);
+  c.protocol.statistics = pr.number("statistics", {.above = 0, .at_most = 1e5}, p.statistics);
+  c.protocol.sample_every = pr.number("sample_every", {.above = 0, .at_most = 100}, 0.5);
+  c.protocol.stationarity_window =
+      pr.number("stationarity_window", {.above = 0, .at_most = 1e4}, 20.0);
+  c.protocol.snapshot_every = pr.number("snapshot_every", duration, 10.0);
+  c.protocol.checkpoint_every_s = pr.number("checkpoint_every_s", {.above = 0}, 600.0);
+  c.protocol.progress_every_s = pr.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
+  c.protocol.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
   pr.finish();
-  if (c.statistics < 20 * c.sample_every)
+  if (c.protocol.statistics < 20 * c.protocol.sample_every)
     throw InputError(
-        "protocol.statistics = " + format_value(c.statistics) +
-        ": must be >= 20 x protocol.sample_every = " + format_value(20 * c.sample_every) +
+        "protocol.statistics = " + format_value(c.protocol.statistics) +
+        ": must be >= 20 x protocol.sample_every = " + format_value(20 * c.protocol.sample_every) +
         " (10 batch means of at least 2 samples each)");
   root.finish();
 
   // ---- lattice-unit quantities (docs/model.md section 2) -----------------------------
-  const int L = static_cast<int>(std::lround(c.length_over_a * a));
-  const int W = static_cast<int>(std::lround(L / c.length_over_width));
-  c.box = {L, W, W};
+  const int L = static_cast<int>(std::lround(c.physics.length_over_a * a));
+  const int W = static_cast<int>(std::lround(L / c.physics.length_over_width));
+  c.derived.box = {L, W, W};
   // Pair observables look up to 3a around each sphere (h(theta), and the
   // well and event ranges, 2(a + delta) plus a skin, are shorter): that must
   // stay below half the box so that a pair has one periodic image only.
   if (W <= 6 * a)
-    throw InputError("L_over_W = " + format_value(c.length_over_width) +
-                     " with L_over_a = " + format_value(c.length_over_a) +
+    throw InputError("L_over_W = " + format_value(c.physics.length_over_width) +
+                     " with L_over_a = " + format_value(c.physics.length_over_a) +
                      ": makes the box width W = " + std::to_string(W) +
                      " cells; must exceed 6a = " + format_value(6 * a) +
                      " so that pairs within 3a have a single periodic image");
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
-  c.sphere_count = single ? 1 : static_cast<int>(std::lround(c.phi * volume / sphere_volume));
+  c.derived.sphere_count =
+      single ? 1 : static_cast<int>(std::lround(c.physics.phi * volume / sphere_volume));
   if (!c.positions_from.empty()) {
-    c.initial_positions = snapshot_positions(c.positions_from, a, c.box);
-    c.sphere_count = static_cast<int>(c.initial_positions.size() / 3);
-    c.phi = c.sphere_count * sphere_volume / volume;
+    c.initial_positions = snapshot_positions(c.positions_from, a, c.derived.box);
+    c.derived.sphere_count = static_cast<int>(c.initial_positions.size() / 3);
+    c.physics.phi = c.derived.sphere_count * sphere_volume / volume;
   }
-  if (c.sphere_count < 1)
-    throw InputError("phi = " + format_value(c.phi) +
+  if (c.derived.sphere_count < 1)
+    throw InputError("phi = " + format_value(c.physics.phi) +
                      ": gives N = 0 spheres in this box; raise phi or L_over_a");
-  c.phi_realised = c.sphere_count * sphere_volume / volume;
-  if (single) c.phi = c.phi_realised;
+  c.derived.phi_realised = c.derived.sphere_count * sphere_volume / volume;
+  if (single) c.physics.phi = c.derived.phi_realised;
 
-  c.drag_coefficient = schiller_naumann_drag_coefficient(c.reynolds_inf);
-  const double U = c.settling_velocity;
-  c.gravity = 0.375 * c.drag_coefficient * U * U / ((c.density_ratio - 1.0) * a);
-  c.convective_time = a / U;
-  c.escape_velocity = c.du_over_uinf * U;
-  c.well_width = c.delta_over_a * a;
+  c.derived.drag_coefficient = schiller_naumann_drag_coefficient(c.physics.reynolds_inf);
+  const double U = c.derived.settling_velocity;
+  c.derived.gravity =
+      0.375 * c.derived.drag_coefficient * U * U / ((c.physics.density_ratio - 1.0) * a);
+  c.derived.convective_time = a / U;
+  c.derived.escape_velocity = c.physics.du_over_uinf * U;
+  c.derived.well_width = c.physics.delta_over_a * a;
   // rho_bar - rho = phi (rho_p - rho); rho_p - rho_bar = (1 - phi)(rho_p - rho)
-  c.liquid_body_force = c.phi_realised * (c.density_ratio - 1.0) * c.gravity;
-  c.sphere_net_gravity =
-      (1.0 - c.phi_realised) * (c.density_ratio - 1.0) * sphere_volume * c.gravity;
+  c.derived.liquid_body_force =
+      c.derived.phi_realised * (c.physics.density_ratio - 1.0) * c.derived.gravity;
+  c.derived.sphere_net_gravity = (1.0 - c.derived.phi_realised) * (c.physics.density_ratio - 1.0) *
+                                 sphere_volume * c.derived.gravity;
 
-  const double bytes =
-      static_cast<double>(c.box.cells()) * 19.0 * (c.single_precision ? 4.0 : 8.0) * 1.25;
+  const double bytes = static_cast<double>(c.derived.box.cells()) * 19.0 *
+                       (c.numerics.single_precision ? 4.0 : 8.0) * 1.25;
   const double available = physical_memory_bytes();
   if (modules_of(c.scene).liquid && available > 0 && bytes > 0.8 * available)
-    throw InputError("L_over_a = " + format_value(c.length_over_a) +
+    throw InputError("L_over_a = " + format_value(c.physics.length_over_a) +
                      ", a_over_dx = " + format_value(a) + ": the " + std::to_string(L) + " x " +
                      std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
                      format_value(bytes / 1e9) + " GB; must fit in 80 % of this machine's " +
@@ -359,66 +369,68 @@ nlohmann::json SuspensionCase::to_json() const {
   nlohmann::json j;
   j["scene"] = std::string(scene_name(scene));
   j["fidelity"] = fidelity;
-  j["precision"] = single_precision ? "float" : "double";
+  j["precision"] = numerics.single_precision ? "float" : "double";
   j["seed"] = seed;
   if (!positions_from.empty())
     j["positions_from"] = positions_from;
   else if (scene != Scene::single_sphere)
-    j["phi"] = phi;
-  j["Re_inf"] = reynolds_inf;
-  j["density_ratio"] = density_ratio;
-  j["du_over_Uinf"] = du_over_uinf;
-  j["delta_over_a"] = delta_over_a;
-  j["restitution"] = restitution;
-  j["friction"] = friction;
-  j["lubrication_model"] = lubrication_model;
-  j["lubrication_integration"] = lubrication_integration;
-  j["lubrication_onset_over_a"] = lubrication_onset_over_a;
-  j["lubrication_saturation_over_a"] = lubrication_saturation_over_a;
-  j["L_over_a"] = length_over_a;
-  j["L_over_W"] = length_over_width;
-  j["numerics"] = {{"a_over_dx", radius_cells}, {"viscosity", viscosity}, {"trt_magic", trt_magic}};
+    j["phi"] = physics.phi;
+  j["Re_inf"] = physics.reynolds_inf;
+  j["density_ratio"] = physics.density_ratio;
+  j["du_over_Uinf"] = physics.du_over_uinf;
+  j["delta_over_a"] = physics.delta_over_a;
+  j["restitution"] = physics.restitution;
+  j["friction"] = physics.friction;
+  j["lubrication_model"] = physics.lubrication_model;
+  j["lubrication_integration"] = physics.lubrication_integration;
+  j["lubrication_onset_over_a"] = physics.lubrication_onset_over_a;
+  j["lubrication_saturation_over_a"] = physics.lubrication_saturation_over_a;
+  j["L_over_a"] = physics.length_over_a;
+  j["L_over_W"] = physics.length_over_width;
+  j["numerics"] = {{"a_over_dx", numerics.radius_cells},
+                   {"viscosity", numerics.viscosity},
+                   {"trt_magic", numerics.trt_magic}};
   if (modules_of(scene).liquid)
     j["numerics"]["immersed_boundary"] = {
-        {"marker_spacing", ib_scheme.marker_spacing},
-        {"sweeps", ib_scheme.sweeps},
-        {"kernel", immersed_boundary::kernel_name(ib_scheme.kernel)}};
-  if (input_radius_given) j["numerics"]["input_radius"] = input_radius;
-  j["protocol"] = {{"stage1_min", stage1_min},
-                   {"stage1_max", stage1_max},
-                   {"stage2_settle", stage2_settle},
-                   {"statistics", statistics},
-                   {"sample_every", sample_every},
-                   {"stationarity_window", stationarity_window},
-                   {"snapshot_every", snapshot_every},
-                   {"checkpoint_every_s", checkpoint_every_s},
-                   {"progress_every_s", progress_every_s},
-                   {"threads", threads}};
+        {"marker_spacing", numerics.ib_scheme.marker_spacing},
+        {"sweeps", numerics.ib_scheme.sweeps},
+        {"kernel", immersed_boundary::kernel_name(numerics.ib_scheme.kernel)}};
+  if (numerics.input_radius_given) j["numerics"]["input_radius"] = numerics.input_radius;
+  j["protocol"] = {{"stage1_min", protocol.stage1_min},
+                   {"stage1_max", protocol.stage1_max},
+                   {"stage2_settle", protocol.stage2_settle},
+                   {"statistics", protocol.statistics},
+                   {"sample_every", protocol.sample_every},
+                   {"stationarity_window", protocol.stationarity_window},
+                   {"snapshot_every", protocol.snapshot_every},
+                   {"checkpoint_every_s", protocol.checkpoint_every_s},
+                   {"progress_every_s", protocol.progress_every_s},
+                   {"threads", protocol.threads}};
   return j;
 }
 
 nlohmann::json SuspensionCase::derived_json() const {
   const std::string input_radius_from =
-      input_radius_given ? std::string("numerics.input_radius")
+      numerics.input_radius_given ? std::string("numerics.input_radius")
       : !modules_of(scene).liquid
           ? std::string("unused (no liquid)")
           : "shipped calibration, interpolated in log nu (nearest entry nu = " +
-                format_value(calibration_viscosity) + ")";
-  return {{"box_cells", {box.nx, box.ny, box.nz}},
-          {"sphere_count", sphere_count},
-          {"phi_realised", phi_realised},
-          {"U_inf", settling_velocity},
-          {"viscosity", viscosity},
-          {"tau", 3 * viscosity + 0.5},
-          {"C_D", drag_coefficient},
-          {"gravity", gravity},
-          {"convective_time_steps", convective_time},
-          {"escape_velocity", escape_velocity},
-          {"well_width", well_width},
-          {"liquid_body_force", liquid_body_force},
-          {"sphere_net_gravity", sphere_net_gravity},
-          {"Mach_U_inf", settling_velocity * std::sqrt(3.0)},
-          {"input_radius", input_radius},
+                format_value(numerics.calibration_viscosity) + ")";
+  return {{"box_cells", {derived.box.nx, derived.box.ny, derived.box.nz}},
+          {"sphere_count", derived.sphere_count},
+          {"phi_realised", derived.phi_realised},
+          {"U_inf", derived.settling_velocity},
+          {"viscosity", numerics.viscosity},
+          {"tau", 3 * numerics.viscosity + 0.5},
+          {"C_D", derived.drag_coefficient},
+          {"gravity", derived.gravity},
+          {"convective_time_steps", derived.convective_time},
+          {"escape_velocity", derived.escape_velocity},
+          {"well_width", derived.well_width},
+          {"liquid_body_force", derived.liquid_body_force},
+          {"sphere_net_gravity", derived.sphere_net_gravity},
+          {"Mach_U_inf", derived.settling_velocity * std::sqrt(3.0)},
+          {"input_radius", numerics.input_radius},
           {"input_radius_from", input_radius_from}};
 }
 

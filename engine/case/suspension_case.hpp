@@ -36,18 +36,10 @@ inline constexpr double kDefaultSettlingVelocity = 0.02;
 // 7 at nu = 0.005).
 double smallest_stable_viscosity(double radius_cells);
 
-struct SuspensionCase {
-  Scene scene = Scene::suspension;
-  std::string fidelity = "standard";
-  bool single_precision = false;
-  std::uint64_t seed = 1;
-
-  // fixed-array only: hold the spheres of this run's snapshot
-  // (spheres/step_N.h5) still instead of placing them at random (paper Fig. 1b)
-  std::string positions_from;
-  std::vector<double> initial_positions;  // its centres, x y z per sphere
-
-  // ---- dimensionless inputs (paper Table 1) --------------------------------
+// The physical problem: the dimensionless groups of the paper's Table 1, the
+// domain's shape in radii, and the choices of contact and lubrication model.
+// The top-level fields of the case file.
+struct Physics {
   double phi = 0.20;                            // requested solids fraction
   double reynolds_inf = 12;                     // Re_inf = U_inf 2a / nu
   double density_ratio = 4.0;                   // rho_p / rho
@@ -67,8 +59,12 @@ struct SuspensionCase {
   std::string lubrication_integration = "implicit";
   double length_over_a = 48;     // L / a
   double length_over_width = 2;  // L / W
+};
 
-  // ---- numerics --------------------------------------------------------------
+// How the problem is discretised: the case file's "numerics" (and "precision"),
+// with what the shipped calibrations give for this resolution and viscosity.
+struct Numerics {
+  bool single_precision = false;
   double radius_cells = 6;  // hydrodynamic radius a / dx
   double viscosity = 0;     // lattice nu (derived when not given)
   double trt_magic = 0.25;
@@ -86,8 +82,10 @@ struct SuspensionCase {
   // and nu, (s/a, lambda_IB) from the shipped close-pair table, interpolated in
   // log(nu) between the calibrated viscosities around this one
   std::vector<std::pair<double, double>> lubrication_lattice_share;
+};
 
-  // ---- protocol (durations in a / U_inf) -------------------------------------
+// The run protocol, the case file's "protocol" (durations in a / U_inf).
+struct Protocol {
   double stage1_min = 20;     // du = 0 stage: at least this long ...
   double stage1_max = 100;    // ... until stationary, at most this long
   double stage2_settle = 50;  // du at target: before statistics start
@@ -98,8 +96,11 @@ struct SuspensionCase {
   double snapshot_every = 10;  // sphere snapshots, a / U_inf (0: none)
   double progress_every_s = 2;
   int threads = 0;
+};
 
-  // ---- derived, lattice units (dx = dt = 1, rho = 1) -------------------------
+// What the solver steps with: Physics and Numerics in lattice units
+// (dx = dt = 1, rho = 1). Never read from the case file.
+struct Derived {
   lattice::Extent box;            // cells: L x W x W
   int sphere_count = 0;           // N
   double phi_realised = 0;        // N (4/3) pi a^3 / V
@@ -111,6 +112,22 @@ struct SuspensionCase {
   double well_width = 0;          // delta
   double liquid_body_force = 0;   // f = (rho_bar - rho) g, along +x
   double sphere_net_gravity = 0;  // (rho_p - rho_bar) V_p g, acting along -x
+};
+
+struct SuspensionCase {
+  Scene scene = Scene::suspension;
+  std::string fidelity = "standard";
+  std::uint64_t seed = 1;
+
+  // fixed-array only: hold the spheres of this run's snapshot
+  // (spheres/step_N.h5) still instead of placing them at random (paper Fig. 1b)
+  std::string positions_from;
+  std::vector<double> initial_positions;  // its centres, x y z per sphere
+
+  Physics physics;
+  Numerics numerics;
+  Protocol protocol;
+  Derived derived;
 
   std::vector<std::string> warnings;
 

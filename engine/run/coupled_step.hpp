@@ -49,11 +49,12 @@ struct Liquid {
   std::vector<std::uint8_t> solid;  // scratch of the liquid averages
 
   explicit Liquid(const cases::SuspensionCase& c)
-      : fluid(c.box, {c.viscosity, c.trt_magic}), ib({c.input_radius, c.ib_scheme, false}) {
-    const double volume = static_cast<double>(c.box.cells());
-    dynamics.external =
-        spheres::settling_forces(static_cast<std::size_t>(c.sphere_count), c.radius_cells,
-                                 c.density_ratio, volume, c.gravity);
+      : fluid(c.derived.box, {c.numerics.viscosity, c.numerics.trt_magic}),
+        ib({c.numerics.input_radius, c.numerics.ib_scheme, false}) {
+    const double volume = static_cast<double>(c.derived.box.cells());
+    dynamics.external = spheres::settling_forces(static_cast<std::size_t>(c.derived.sphere_count),
+                                                 c.numerics.radius_cells, c.physics.density_ratio,
+                                                 volume, c.derived.gravity);
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
     fluid.enable_force_field();
   }
@@ -73,17 +74,17 @@ class CoupledStep {
   // `escape_velocity`: the square well's strength at the start (the protocol's).
   CoupledStep(const cases::SuspensionCase& c, double escape_velocity, TimedStages& stages)
       : modules_(cases::modules_of(c.scene)),
-        box_{spheres::Vec3(c.box.nx, c.box.ny, c.box.nz)},
-        contacts_({.restitution = c.restitution,
-                   .friction = c.friction,
+        box_{spheres::Vec3(c.derived.box.nx, c.derived.box.ny, c.derived.box.nz)},
+        contacts_({.restitution = c.physics.restitution,
+                   .friction = c.physics.friction,
                    .escape_velocity = escape_velocity,
-                   .well_width = c.well_width}),
-        lubrication_({.viscosity = c.viscosity,
+                   .well_width = c.derived.well_width}),
+        lubrication_({.viscosity = c.numerics.viscosity,
                       .liquid_density = 1.0,
-                      .onset_gap = c.lubrication_onset_over_a,
-                      .saturation_gap = c.lubrication_saturation_over_a,
-                      .lattice_share = c.lubrication_lattice_share,
-                      .explicit_euler = c.lubrication_integration == "explicit-paper"}),
+                      .onset_gap = c.physics.lubrication_onset_over_a,
+                      .saturation_gap = c.physics.lubrication_saturation_over_a,
+                      .lattice_share = c.numerics.lubrication_lattice_share,
+                      .explicit_euler = c.physics.lubrication_integration == "explicit-paper"}),
         stages_(stages) {
     // The stages a scene reports: those of the liquid's coupling wherever
     // there is a liquid, events always (0 s without contacts).

@@ -11,19 +11,19 @@ namespace flocsim::run {
 namespace {
 
 Protocol::Durations durations_of(const cases::SuspensionCase& c) {
-  const double T = c.convective_time;
+  const double T = c.derived.convective_time;
   auto steps = [T](double in_convective_times) {
     return static_cast<long>(std::llround(in_convective_times * T));
   };
   Protocol::Durations d;
-  d.sample = std::max(1L, steps(c.sample_every));
-  d.stage1_min = steps(c.stage1_min);
-  d.stage1_max = steps(c.stage1_max);
-  d.settle = steps(c.stage2_settle);
-  d.statistics = std::max(d.sample, steps(c.statistics));
-  d.snapshot = c.snapshot_every > 0 ? std::max(1L, steps(c.snapshot_every)) : 0;
-  d.window_samples =
-      std::max(5L, static_cast<long>(std::llround(c.stationarity_window / c.sample_every)));
+  d.sample = std::max(1L, steps(c.protocol.sample_every));
+  d.stage1_min = steps(c.protocol.stage1_min);
+  d.stage1_max = steps(c.protocol.stage1_max);
+  d.settle = steps(c.protocol.stage2_settle);
+  d.statistics = std::max(d.sample, steps(c.protocol.statistics));
+  d.snapshot = c.protocol.snapshot_every > 0 ? std::max(1L, steps(c.protocol.snapshot_every)) : 0;
+  d.window_samples = std::max(5L, static_cast<long>(std::llround(c.protocol.stationarity_window /
+                                                                 c.protocol.sample_every)));
   return d;
 }
 
@@ -33,11 +33,11 @@ Protocol::Protocol(const cases::SuspensionCase& c, const cases::SceneModules& mo
     : d_(durations_of(c)),
       signal_(modules.liquid ? result_names::column::U_over_Uinf
                              : result_names::column::granular_temperature),
-      convective_time_(c.convective_time),
-      du_over_uinf_(c.du_over_uinf),
-      target_escape_velocity_(c.escape_velocity),
+      convective_time_(c.derived.convective_time),
+      du_over_uinf_(c.physics.du_over_uinf),
+      target_escape_velocity_(c.derived.escape_velocity),
       // stage 2 exists only where a square well acts
-      has_stage2_(modules.contacts && c.escape_velocity > 0) {}
+      has_stage2_(modules.contacts && c.derived.escape_velocity > 0) {}
 
 bool Protocol::done(long step) const {
   return statistics_start_ >= 0 && step - statistics_start_ >= d_.statistics;

@@ -104,10 +104,10 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, Spher
   s.spheres.position = unflatten(f.read<double>("/spheres/position"));
   s.spheres.velocity = unflatten(f.read<double>("/spheres/velocity"));
   s.spheres.angular_velocity = unflatten(f.read<double>("/spheres/angular_velocity"));
-  if (s.spheres.position.size() != static_cast<std::size_t>(c.sphere_count))
+  if (s.spheres.position.size() != static_cast<std::size_t>(c.derived.sphere_count))
     throw std::runtime_error(file.string() + ": holds " +
                              std::to_string(s.spheres.position.size()) + " spheres, the case has " +
-                             std::to_string(c.sphere_count));
+                             std::to_string(c.derived.sphere_count));
   const auto pairs = f.read<std::int64_t>("/spheres/attached_pairs");
   std::vector<std::pair<int, int>> attached;
   for (std::size_t k = 0; k + 1 < pairs.size(); k += 2)

@@ -56,7 +56,7 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
                             const Protocol& protocol, const events::DirectInteractions& contacts,
                             double worst_momentum_drift) {
   const cases::SceneModules& modules = cases::modules_of(c.scene);
-  const double a = c.radius_cells;
+  const double a = c.numerics.radius_cells;
   const double mass = s.spheres.mass();
   auto window = [&](std::string_view name) {
     return statistics_window(s, protocol.statistics_start(), name);
@@ -74,7 +74,7 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
     const auto f_all = window(column::F_all_cells);
     if (std::none_of(f_all.begin(), f_all.end(), [](double v) { return std::isnan(v); }))
       obs[key(observable::F_all_cells)] = steady(f_all);
-    const double phi = c.phi_realised;
+    const double phi = c.derived.phi_realised;
     const double re = obs[key(observable::Re)]["mean"].get<double>();
     nlohmann::json ref;
     ref["beetstra_F_at_measured_Re"] = observables::beetstra_drag(phi, re);
@@ -82,21 +82,24 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
         "F = F_h / (6 pi mu a U), F_h = f V_p (1/phi - 1), U superficial, Re = 2aU/nu";
     if (c.scene == cases::Scene::suspension) {
       ref["richardson_zaki_U_over_Uinf"] =
-          observables::richardson_zaki_velocity_ratio(phi, c.reynolds_inf);
-      ref["richardson_zaki_exponent"] = observables::richardson_zaki_exponent(c.reynolds_inf);
-      ref["beetstra_U_over_Uinf"] = observables::beetstra_velocity_ratio(phi, c.reynolds_inf);
+          observables::richardson_zaki_velocity_ratio(phi, c.physics.reynolds_inf);
+      ref["richardson_zaki_exponent"] =
+          observables::richardson_zaki_exponent(c.physics.reynolds_inf);
+      ref["beetstra_U_over_Uinf"] =
+          observables::beetstra_velocity_ratio(phi, c.physics.reynolds_inf);
     }
-    if (c.scene == cases::Scene::single_sphere && c.box.nx == c.box.ny && c.box.ny == c.box.nz) {
+    if (c.scene == cases::Scene::single_sphere && c.derived.box.nx == c.derived.box.ny &&
+        c.derived.box.ny == c.derived.box.nz) {
       // creeping-flow hindrance of the simple cubic array the periodic box makes
-      ref["sangani_acrivos_K"] = calibration::sangani_acrivos_drag(2 * a / c.box.nx);
+      ref["sangani_acrivos_K"] = calibration::sangani_acrivos_drag(2 * a / c.derived.box.nx);
     }
     obs["references"] = ref;
     if (modules.spheres_move)
       obs["momentum_balance"] = {
           {"worst_drift", worst_momentum_drift},
           {"relative_to_sphere_momentum",
-           worst_momentum_drift /
-               std::max(1e-300, std::abs(mass * c.sphere_count * c.settling_velocity))},
+           worst_momentum_drift / std::max(1e-300, std::abs(mass * c.derived.sphere_count *
+                                                            c.derived.settling_velocity))},
           {"what", "lattice momentum + sum (m_p u_p - P_in), x, minus its first sample"}};
   } else {
     const auto samples = window(column::kinetic_energy);
@@ -109,7 +112,7 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
       const auto times = window(column::time);
       const double span = times.back() - times.front();
       obs["collisions_per_sphere_per_convective_time"] =
-          (collisions.back() - collisions.front()) / c.sphere_count / span;
+          (collisions.back() - collisions.front()) / c.derived.sphere_count / span;
     }
   }
   Distributions dist;
@@ -127,12 +130,12 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
   obs["g_r"] = {{"r_over_a", dist.r_over_a}, {"g", dist.g}};
   obs["h_theta"] = {{"theta", dist.theta}, {"h", dist.h}, {"pairs_closer_than", "3a"}};
   obs["microstructure_configurations"] = s.microstructure.configurations();
-  obs["window"] = {{"start", protocol.statistics_start() / c.convective_time},
-                   {"end", s.step / c.convective_time},
+  obs["window"] = {{"start", protocol.statistics_start() / c.derived.convective_time},
+                   {"end", s.step / c.derived.convective_time},
                    {"unit", "a/U_inf"},
                    {"samples", static_cast<long>(n_samples)}};
   obs["stage2_start"] = protocol.stage2_start() >= 0
-                            ? nlohmann::json(protocol.stage2_start() / c.convective_time)
+                            ? nlohmann::json(protocol.stage2_start() / c.derived.convective_time)
                             : nullptr;
   obs["stage1_stationary"] = protocol.stage1_stationary();
   const auto& k = contacts.counters();

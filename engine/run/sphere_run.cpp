@@ -37,21 +37,21 @@ constexpr std::string_view kCheckpointStage = "checkpoint";
 // g(r) with bins of 0.05a up to 5a (or just under half the box), h(theta)
 // with bins of pi/60 for pairs closer than 3a.
 observables::PairStructure pair_structure_for(const cases::SuspensionCase& c) {
-  const double a = c.radius_cells;
-  const double half_box = 0.5 * std::min({c.box.nx, c.box.ny, c.box.nz});
+  const double a = c.numerics.radius_cells;
+  const double half_box = 0.5 * std::min({c.derived.box.nx, c.derived.box.ny, c.derived.box.nz});
   return observables::PairStructure(std::min(5.0 * a, half_box - 0.05 * a), 0.05 * a, 3.0 * a,
                                     M_PI / 60);
 }
 
 // Slabs of phi(x, t): one per sphere radius along x.
 int phi_slabs(const cases::SuspensionCase& c) {
-  return std::max(1, static_cast<int>(std::lround(c.box.nx / c.radius_cells)));
+  return std::max(1, static_cast<int>(std::lround(c.derived.box.nx / c.numerics.radius_cells)));
 }
 
 // Initial positions and velocities of a fresh start.
 void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
                    const spheres::PeriodicBox& box, spheres::SphereSet& s) {
-  s.resize(static_cast<std::size_t>(c.sphere_count));
+  s.resize(static_cast<std::size_t>(c.derived.sphere_count));
   if (c.scene == cases::Scene::single_sphere) {
     s.position[0] = 0.5 * box.length;
     return;
@@ -62,14 +62,15 @@ void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
                            c.initial_positions[3 * i + 2]);
     return;  // held still where a snapshot left them
   }
-  s.position = placement::place_randomly({c.sphere_count, c.radius_cells, 0.0, c.seed}, box);
+  s.position = placement::place_randomly(
+      {c.derived.sphere_count, c.numerics.radius_cells, 0.0, c.seed}, box);
   if (m.liquid) return;  // spheres and liquid start at rest
   // granular gas: Maxwellian velocities with U_inf per component, no net momentum
   std::mt19937_64 rng(c.seed + 1);
-  std::normal_distribution<double> maxwell(0.0, c.settling_velocity);
+  std::normal_distribution<double> maxwell(0.0, c.derived.settling_velocity);
   Vec3 mean = Vec3::Zero();
   for (auto& v : s.velocity) mean += (v = Vec3(maxwell(rng), maxwell(rng), maxwell(rng)));
-  mean /= static_cast<double>(c.sphere_count);
+  mean /= static_cast<double>(c.derived.sphere_count);
   for (auto& v : s.velocity) v -= mean;
 }
 
@@ -85,10 +86,11 @@ template <class Real>
 std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
                         const Protocol& protocol, SphereRunState& s, int slabs,
                         double& worst_momentum_drift) {
-  const double a = c.radius_cells;
+  const double a = c.numerics.radius_cells;
   const double mass = s.spheres.mass();
   const spheres::PeriodicBox& box = step.box();
-  const auto agg = observables::find_aggregates(s.spheres.position, box, 2.0 * (a + c.well_width));
+  const auto agg =
+      observables::find_aggregates(s.spheres.position, box, 2.0 * (a + c.derived.well_width));
   const double T = observables::granular_temperature(s.spheres.velocity);
   double kinetic = 0;
   Vec3 sphere_mean = Vec3::Zero();
@@ -98,12 +100,12 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
   }
   sphere_mean /= static_cast<double>(s.spheres.size());
   const SphereSample row{.step = static_cast<double>(s.step),
-                         .time = s.step / c.convective_time,
+                         .time = s.step / c.derived.convective_time,
                          .stage = static_cast<double>(protocol.stage()),
                          .C_sph = agg.contacts_per_sphere,
                          .mean_aggregate_size = agg.mean_size,
                          .granular_temperature = T,
-                         .Re_T = std::sqrt(T) * 2 * a / c.viscosity,
+                         .Re_T = std::sqrt(T) * 2 * a / c.numerics.viscosity,
                          .kinetic_energy = kinetic,
                          .well_energy = step.contacts().well_energy(s.spheres),
                          .collisions = static_cast<double>(step.contacts().counters().collisions)};
@@ -111,8 +113,8 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
     const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
     std::string sick = health(s.spheres, l.mass);
     if (!sick.empty()) return sick;
-    const double U =
-        observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(), c.phi_realised);
+    const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
+                                                            c.derived.phi_realised);
     // lattice momentum + sum (m_p u_p - P_in): constant (sphere_dynamics.hpp)
     double balance = l.lattice_momentum_x;
     for (std::size_t i = 0; i < s.spheres.size(); ++i)
@@ -125,20 +127,21 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
     }
     const double drift = step.modules().spheres_move ? balance - s.momentum_initial : 0.0;
     // the other reading of <u>: every cell, the liquid inside the spheres too
-    const double U_all = observables::superficial_slip_velocity(l.mean_velocity_x_all_cells,
-                                                                sphere_mean.x(), c.phi_realised);
+    const double U_all = observables::superficial_slip_velocity(
+        l.mean_velocity_x_all_cells, sphere_mean.x(), c.derived.phi_realised);
     const double body = liquid->dynamics.external.liquid_body_force.x();
     const LiquidSample liquid_row{
-        .U_over_Uinf = U / c.settling_velocity,
+        .U_over_Uinf = U / c.derived.settling_velocity,
         .U = U,
-        .F = observables::dimensionless_drag(body, a, c.phi_realised, c.viscosity, U),
-        .Re = U * 2 * a / c.viscosity,
+        .F = observables::dimensionless_drag(body, a, c.derived.phi_realised, c.numerics.viscosity,
+                                             U),
+        .Re = U * 2 * a / c.numerics.viscosity,
         .liquid_velocity = l.mean_velocity_x,
         .sphere_velocity = sphere_mean.x(),
         .momentum_balance = drift,
         .liquid_velocity_all_cells = l.mean_velocity_x_all_cells,
-        .F_all_cells =
-            observables::dimensionless_drag(body, a, c.phi_realised, c.viscosity, U_all)};
+        .F_all_cells = observables::dimensionless_drag(body, a, c.derived.phi_realised,
+                                                       c.numerics.viscosity, U_all)};
     worst_momentum_drift = std::max(worst_momentum_drift, std::abs(drift));
     s.series.append(row, &liquid_row);
   } else {
@@ -156,7 +159,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
 
 template <class Real>
 RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
-  RunShell shell(o, c.to_json(), c.warnings, c.threads);
+  RunShell shell(o, c.to_json(), c.warnings, c.protocol.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
   RunLog& log = shell.log();
   const cases::SceneModules& modules = cases::modules_of(c.scene);
@@ -173,9 +176,9 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   Liquid<Real>* liquid = step.liquid();
 
   SphereRunState s(modules.liquid);
-  s.spheres.radius = c.radius_cells;
-  s.spheres.density_ratio = c.density_ratio;
-  s.size_distribution_sum.assign(static_cast<std::size_t>(c.sphere_count) + 1, 0.0);
+  s.spheres.radius = c.numerics.radius_cells;
+  s.spheres.density_ratio = c.physics.density_ratio;
+  s.size_distribution_sum.assign(static_cast<std::size_t>(c.derived.sphere_count) + 1, 0.0);
   s.microstructure = pair_structure_for(c);
   const int slabs = phi_slabs(c);
   const std::filesystem::path& checkpoint = shell.checkpoint_file();
@@ -185,28 +188,30 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   } else {
     place_spheres(c, modules, box, s.spheres);
   }
-  log.info(std::string("flocsim ") + kFlocsimVersion + " " +
-           std::string(cases::scene_name(c.scene)) + " scene: " + std::to_string(c.sphere_count) +
-           " spheres of radius " + std::to_string(c.radius_cells) +
-           (modules.liquid ? " (markers at a_g = " + std::to_string(c.input_radius) + ")" : "") +
-           " in " + std::to_string(c.box.nx) + " x " + std::to_string(c.box.ny) + " x " +
-           std::to_string(c.box.nz) + ", phi = " + std::to_string(c.phi_realised) +
-           ", a/U_inf = " + std::to_string(c.convective_time) + " steps" +
-           (modules.liquid ? std::string(", ") + (sizeof(Real) == 8 ? "double" : "float") +
-                                 " lattice, nu = " + std::to_string(c.viscosity)
-                           : std::string()) +
-           ", " + std::to_string(omp_get_max_threads()) + " threads");
+  log.info(
+      std::string("flocsim ") + kFlocsimVersion + " " + std::string(cases::scene_name(c.scene)) +
+      " scene: " + std::to_string(c.derived.sphere_count) + " spheres of radius " +
+      std::to_string(c.numerics.radius_cells) +
+      (modules.liquid ? " (markers at a_g = " + std::to_string(c.numerics.input_radius) + ")"
+                      : "") +
+      " in " + std::to_string(c.derived.box.nx) + " x " + std::to_string(c.derived.box.ny) + " x " +
+      std::to_string(c.derived.box.nz) + ", phi = " + std::to_string(c.derived.phi_realised) +
+      ", a/U_inf = " + std::to_string(c.derived.convective_time) + " steps" +
+      (modules.liquid ? std::string(", ") + (sizeof(Real) == 8 ? "double" : "float") +
+                            " lattice, nu = " + std::to_string(c.numerics.viscosity)
+                      : std::string()) +
+      ", " + std::to_string(omp_get_max_threads()) + " threads");
 
-  const long cells = modules.liquid ? c.box.cells() : 0;
+  const long cells = modules.liquid ? c.derived.box.cells() : 0;
   ProgressReporter progress(log, o.out_dir / "progress.json", s.step,
-                            protocol.expected_total(s.step), cells, c.progress_every_s);
+                            protocol.expected_total(s.step), cells, c.protocol.progress_every_s);
   shell.set_first_step(s.step);
   bool done = protocol.done(s.step);
   double worst_momentum_drift = 0;
 
   auto fail = [&](const std::string& what) {
-    return shell.blown_up("step " + std::to_string(s.step) +
-                              " (t U_inf/a = " + std::to_string(s.step / c.convective_time) + ")",
+    return shell.blown_up("step " + std::to_string(s.step) + " (t U_inf/a = " +
+                              std::to_string(s.step / c.derived.convective_time) + ")",
                           what,
                           "U_inf too high for the Mach limit, a viscosity too small for the "
                           "resolution, or a density ratio near 1");
@@ -229,14 +234,15 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     }
     if (d.snapshot > 0 && (s.step % d.snapshot == 0 || done)) {
       stages.run(output_stage, [&] {
-        const auto agg = observables::find_aggregates(s.spheres.position, box,
-                                                      2.0 * (c.radius_cells + c.well_width));
-        output::write_sphere_snapshot(o.out_dir / "spheres", s.step, s.step / c.convective_time,
-                                      s.spheres, agg.aggregate_of);
+        const auto agg = observables::find_aggregates(
+            s.spheres.position, box, 2.0 * (c.numerics.radius_cells + c.derived.well_width));
+        output::write_sphere_snapshot(o.out_dir / "spheres", s.step,
+                                      s.step / c.derived.convective_time, s.spheres,
+                                      agg.aggregate_of);
       });
     }
     const bool stop_now = shell.stop_requested(s.step);
-    if (!done && (stop_now || shell.checkpoint_due(s.step, c.checkpoint_every_s))) {
+    if (!done && (stop_now || shell.checkpoint_due(s.step, c.protocol.checkpoint_every_s))) {
       // only a healthy state is checkpointed: the last good one is never replaced by a bad one
       const std::string sick = health(s.spheres, liquid ? liquid->fluid.total_mass() : 0.0);
       if (!sick.empty()) return fail(sick);
@@ -253,12 +259,12 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
       const std::string phase = protocol.phase();
       if (liquid)
         std::snprintf(extra, sizeof extra, "%s | t U/a %.1f | U/U_inf %.3f | C_sph %.3f",
-                      phase.c_str(), s.step / c.convective_time,
+                      phase.c_str(), s.step / c.derived.convective_time,
                       s.series[column::U_over_Uinf].back(), s.series[column::C_sph].back());
       else
         std::snprintf(extra, sizeof extra, "%s | t U/a %.1f | C_sph %.3f | <n_a> %.3f",
-                      phase.c_str(), s.step / c.convective_time, s.series[column::C_sph].back(),
-                      s.series[column::mean_aggregate_size].back());
+                      phase.c_str(), s.step / c.derived.convective_time,
+                      s.series[column::C_sph].back(), s.series[column::mean_aggregate_size].back());
       progress.update(s.step, extra);
     }
   }
@@ -289,7 +295,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   result["cost"] = cost;
   return shell.complete(std::move(result), wall,
                         std::to_string(s.step) + " steps (" +
-                            std::to_string(s.step / c.convective_time) + " a/U_inf)");
+                            std::to_string(s.step / c.derived.convective_time) + " a/U_inf)");
 }
 
 }  // namespace
@@ -303,7 +309,7 @@ RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& o) {
                             "\": has no spheres; the sphere run takes " + list);
   }
   return run_guarded(o.out_dir, [&] {
-    return c.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
+    return c.numerics.single_precision ? run_scene<float>(c, o) : run_scene<double>(c, o);
   });
 }
 

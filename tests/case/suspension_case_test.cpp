@@ -43,12 +43,12 @@ TEST(SuspensionCase, PaperDomainGivesThePapersSphereCounts) {
   for (int k = 0; k < 4; ++k) {
     const SuspensionCase c =
         parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", phis[k]}});
-    EXPECT_EQ(c.box.nx, 288);
-    EXPECT_EQ(c.box.ny, 144);
-    EXPECT_EQ(c.box.nz, 144);
-    EXPECT_EQ(c.sphere_count, rounded_n[k]) << "phi = " << phis[k];
-    EXPECT_NEAR(c.sphere_count / paper_n[k], 1.0, 0.005) << "phi = " << phis[k];
-    EXPECT_NEAR(c.phi_realised, phis[k], 0.5 / 6600.5);  // within half a sphere
+    EXPECT_EQ(c.derived.box.nx, 288);
+    EXPECT_EQ(c.derived.box.ny, 144);
+    EXPECT_EQ(c.derived.box.nz, 144);
+    EXPECT_EQ(c.derived.sphere_count, rounded_n[k]) << "phi = " << phis[k];
+    EXPECT_NEAR(c.derived.sphere_count / paper_n[k], 1.0, 0.005) << "phi = " << phis[k];
+    EXPECT_NEAR(c.derived.phi_realised, phis[k], 0.5 / 6600.5);  // within half a sphere
   }
 }
 
@@ -58,13 +58,13 @@ TEST(SuspensionCase, LatticeUnitsByHand) {
   // g = (3/8) C_D U^2 / ((rho_p/rho - 1) a) = 0.375 * 3.653936 * 4e-4 / 18.
   const SuspensionCase c =
       parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 12}});
-  EXPECT_DOUBLE_EQ(c.settling_velocity, 0.02);
-  EXPECT_NEAR(c.viscosity, 0.02, 1e-15);
-  EXPECT_NEAR(c.drag_coefficient, 3.653936, 2e-6);
-  EXPECT_NEAR(c.gravity, 0.375 * 3.653936 * 4e-4 / 18, 1e-10);
-  EXPECT_NEAR(c.convective_time, 300.0, 1e-12);
-  EXPECT_DOUBLE_EQ(c.escape_velocity, 0.0);
-  EXPECT_NEAR(c.well_width, 0.15, 1e-15);
+  EXPECT_DOUBLE_EQ(c.derived.settling_velocity, 0.02);
+  EXPECT_NEAR(c.numerics.viscosity, 0.02, 1e-15);
+  EXPECT_NEAR(c.derived.drag_coefficient, 3.653936, 2e-6);
+  EXPECT_NEAR(c.derived.gravity, 0.375 * 3.653936 * 4e-4 / 18, 1e-10);
+  EXPECT_NEAR(c.derived.convective_time, 300.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c.derived.escape_velocity, 0.0);
+  EXPECT_NEAR(c.derived.well_width, 0.15, 1e-15);
 }
 
 TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
@@ -72,13 +72,15 @@ TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
   // 1320 / 6600.5), Re_inf = 12, U = 0.02: f = phi (rho_p - rho) g.
   const SuspensionCase p =
       parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
-  EXPECT_NEAR(p.liquid_body_force, (1320 / (27648 / (4 * M_PI / 3))) * 3 * p.gravity, 1e-18);
+  EXPECT_NEAR(p.derived.liquid_body_force,
+              (1320 / (27648 / (4 * M_PI / 3))) * 3 * p.derived.gravity, 1e-18);
   // docs/model.md section 1: f V (1 - phi) = N (rho_p - rho_bar) (4/3) pi a^3 g.
   const SuspensionCase c =
       parse_suspension_case({{"scene", "suspension"}, {"phi", 0.25}, {"Re_inf", 24}});
-  const double volume = static_cast<double>(c.box.cells());
-  EXPECT_NEAR(c.liquid_body_force * volume * (1 - c.phi_realised),
-              c.sphere_count * c.sphere_net_gravity, 1e-12 * c.sphere_count * c.sphere_net_gravity);
+  const double volume = static_cast<double>(c.derived.box.cells());
+  EXPECT_NEAR(c.derived.liquid_body_force * volume * (1 - c.derived.phi_realised),
+              c.derived.sphere_count * c.derived.sphere_net_gravity,
+              1e-12 * c.derived.sphere_count * c.derived.sphere_net_gravity);
 }
 
 TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
@@ -86,8 +88,8 @@ TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
   // keeps nu = 0.005 and raises U_inf to 72 * 0.005 / 12 = 0.03.
   const SuspensionCase c =
       parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}, {"Re_inf", 72}});
-  EXPECT_DOUBLE_EQ(c.viscosity, 0.005);
-  EXPECT_NEAR(c.settling_velocity, 0.03, 1e-15);
+  EXPECT_DOUBLE_EQ(c.numerics.viscosity, 0.005);
+  EXPECT_NEAR(c.derived.settling_velocity, 0.03, 1e-15);
   for (const auto& w : c.warnings) EXPECT_EQ(w.find("smallest tested"), std::string::npos) << w;
 }
 
@@ -96,8 +98,8 @@ TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
                                                   {"fidelity", "draft"},
                                                   {"phi", 0.2},
                                                   {"numerics", {{"a_over_dx", 8}}}});
-  EXPECT_EQ(c.radius_cells, 8);
-  EXPECT_EQ(c.box.nx, 16 * 8);  // draft domain L = 16a with the explicit a
+  EXPECT_EQ(c.numerics.radius_cells, 8);
+  EXPECT_EQ(c.derived.box.nx, 16 * 8);  // draft domain L = 16a with the explicit a
   // and the canonical form reads back to the same case
   EXPECT_EQ(parse_suspension_case(c.to_json()).to_json(), c.to_json());
 }
@@ -145,18 +147,18 @@ TEST(SuspensionCase, BadInputsAreNamed) {
 TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
   SuspensionCase c = parse_suspension_case(
       {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"viscosity", 0.02}}}});
-  EXPECT_NEAR(c.input_radius, 5.5789, 1e-4);
-  EXPECT_DOUBLE_EQ(c.calibration_viscosity, 0.02);
+  EXPECT_NEAR(c.numerics.input_radius, 5.5789, 1e-4);
+  EXPECT_DOUBLE_EQ(c.numerics.calibration_viscosity, 0.02);
   c = parse_suspension_case(
       {{"scene", "single-sphere"}, {"Re_inf", 1}, {"numerics", {{"viscosity", 0.15}}}});  // 1/6
   // between the entries at nu = 0.08 (a_g 5.593528) and 1/6 (5.612012), by hand:
   // 5.593528 + ln(0.15 / 0.08) / ln((1/6) / 0.08) (5.612012 - 5.593528) = 5.609359
-  EXPECT_NEAR(c.input_radius, 5.609359, 2e-6);
-  EXPECT_DOUBLE_EQ(c.calibration_viscosity, 1.0 / 6.0);
+  EXPECT_NEAR(c.numerics.input_radius, 5.609359, 2e-6);
+  EXPECT_DOUBLE_EQ(c.numerics.calibration_viscosity, 1.0 / 6.0);
   c = parse_suspension_case({{"scene", "fixed-array"},
                              {"phi", 0.2},
                              {"numerics", {{"a_over_dx", 5}, {"input_radius", 4.6}}}});
-  EXPECT_DOUBLE_EQ(c.input_radius, 4.6);
+  EXPECT_DOUBLE_EQ(c.numerics.input_radius, 4.6);
   EXPECT_EQ(c.to_json()["numerics"]["input_radius"], 4.6);
   const json uncalibrated = {
       {"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 5}}}};
@@ -177,7 +179,7 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
 // the command that would calibrate it.
 TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
   const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}});
-  EXPECT_EQ(c.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_EQ(c.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"],
             json({{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}}));
   const json odd = {
@@ -217,8 +219,8 @@ TEST(SuspensionCase, FixedArrayFromASnapshot) {
             {"positions_from", file},
             {"numerics", {{"a_over_dx", 4}}}};
   const SuspensionCase c = parse_suspension_case(d);  // draft: 64 x 32 x 32 cells
-  EXPECT_EQ(c.sphere_count, 3);
-  EXPECT_NEAR(c.phi_realised, 3 * (4.0 / 3.0) * M_PI * 64 / (64.0 * 32 * 32), 1e-15);
+  EXPECT_EQ(c.derived.sphere_count, 3);
+  EXPECT_NEAR(c.derived.phi_realised, 3 * (4.0 / 3.0) * M_PI * 64 / (64.0 * 32 * 32), 1e-15);
   EXPECT_EQ(c.initial_positions[6], 30.0);
   EXPECT_EQ(c.to_json()["positions_from"], file);
 

@@ -25,10 +25,10 @@ inline RadialLubrication lubrication_of_case(double a, double nu) {
                                     {"lubrication_model", "calibrated"},
                                     {"Re_inf", 2 * a * 0.01 / nu},
                                     {"numerics", {{"a_over_dx", a}, {"viscosity", nu}}}});
-  return RadialLubrication({.viscosity = c.viscosity,
-                            .onset_gap = c.lubrication_onset_over_a,
-                            .saturation_gap = c.lubrication_saturation_over_a,
-                            .lattice_share = c.lubrication_lattice_share});
+  return RadialLubrication({.viscosity = c.numerics.viscosity,
+                            .onset_gap = c.physics.lubrication_onset_over_a,
+                            .saturation_gap = c.physics.lubrication_saturation_over_a,
+                            .lattice_share = c.numerics.lubrication_lattice_share});
 }
 
 // Every gap within 15 % of the exact resistance, approaching and separating,

@@ -47,13 +47,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
   const cases::SuspensionCase c = small_suspension();
-  EXPECT_EQ(c.sphere_count, 33);
+  EXPECT_EQ(c.derived.sphere_count, 33);
   const fs::path dir = fresh_dir("ci_suspension");
   const auto t0 = std::chrono::steady_clock::now();
   const RunReport r = run_sphere_case(c, {dir, false, true, 0});
-  std::printf("CI-sized suspension (%d x %d x %d cells, %d spheres, %ld steps): %.1f s\n", c.box.nx,
-              c.box.ny, c.box.nz, c.sphere_count, r.result["cost"]["steps"].get<long>(),
-              seconds_since(t0));
+  std::printf("CI-sized suspension (%d x %d x %d cells, %d spheres, %ld steps): %.1f s\n",
+              c.derived.box.nx, c.derived.box.ny, c.derived.box.nz, c.derived.sphere_count,
+              r.result["cost"]["steps"].get<long>(), seconds_since(t0));
   ASSERT_EQ(r.outcome, RunOutcome::completed);
   for (const char* f :
        {"result.json", "run.log", "progress.json", "series.h5", "spheres.xdmf", "fields.xdmf"})
@@ -72,7 +72,8 @@ TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
   EXPECT_LT(obs["U_over_Uinf"]["mean"].get<double>(), 1.0);
   // F and Re are U in other units: F U = f V_p (1/phi - 1) / (6 pi mu a), Re = 2aU/nu
   const double U = obs["U"]["mean"].get<double>();
-  EXPECT_NEAR(obs["Re"]["mean"].get<double>(), U * 2 * c.radius_cells / c.viscosity, 1e-9);
+  EXPECT_NEAR(obs["Re"]["mean"].get<double>(),
+              U * 2 * c.numerics.radius_cells / c.numerics.viscosity, 1e-9);
   EXPECT_TRUE(obs["references"].contains("beetstra_F_at_measured_Re"));
   EXPECT_TRUE(obs["references"].contains("richardson_zaki_U_over_Uinf"));
   // the well was switched on and attached pairs
@@ -116,8 +117,8 @@ TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
   fixed["protocol"]["statistics"] = 0.4;
   fixed["protocol"]["sample_every"] = 0.02;
   const cases::SuspensionCase fc = cases::parse_suspension_case(fixed);
-  EXPECT_EQ(fc.sphere_count, c.sphere_count);
-  EXPECT_DOUBLE_EQ(fc.phi_realised, c.phi_realised);
+  EXPECT_EQ(fc.derived.sphere_count, c.derived.sphere_count);
+  EXPECT_DOUBLE_EQ(fc.derived.phi_realised, c.derived.phi_realised);
   const fs::path fixed_dir = fresh_dir("fixed_from_snapshot");
   const RunReport rf = run_sphere_case(fc, {fixed_dir, false, true, 0});
   ASSERT_EQ(rf.outcome, RunOutcome::completed);
@@ -196,9 +197,9 @@ TEST(LiquidScenes, CornersOfTheParameterSpaceStayStable) {
     std::printf(
         "phi %.2f Re_inf %g du %.2f (nu %.4f, tau %.3f, %d spheres, %ld steps): U/U_inf "
         "%.3f, max overlap %.2e, momentum drift %.2e\n",
-        k.phi, k.re_inf, k.du, c.viscosity, 3 * c.viscosity + 0.5, c.sphere_count,
-        r.result["cost"]["steps"].get<long>(), obs["U_over_Uinf"]["mean"].get<double>(),
-        obs["events"]["worst_overlap"].get<double>(),
+        k.phi, k.re_inf, k.du, c.numerics.viscosity, 3 * c.numerics.viscosity + 0.5,
+        c.derived.sphere_count, r.result["cost"]["steps"].get<long>(),
+        obs["U_over_Uinf"]["mean"].get<double>(), obs["events"]["worst_overlap"].get<double>(),
         obs["momentum_balance"]["relative_to_sphere_momentum"].get<double>());
     EXPECT_TRUE(std::isfinite(obs["U_over_Uinf"]["mean"].get<double>()));
     EXPECT_GT(obs["U_over_Uinf"]["mean"].get<double>(), 0.0);
@@ -239,15 +240,15 @@ json creeping_cube(const std::string& scene) {
 
 void expect_sangani_acrivos(const std::string& scene) {
   const cases::SuspensionCase c = cases::parse_suspension_case(creeping_cube(scene));
-  ASSERT_EQ(c.sphere_count, 1);
-  ASSERT_EQ(c.box.nx, 32);
-  ASSERT_EQ(c.box.nz, 32);
+  ASSERT_EQ(c.derived.sphere_count, 1);
+  ASSERT_EQ(c.derived.box.nx, 32);
+  ASSERT_EQ(c.derived.box.nz, 32);
   const fs::path dir = fresh_dir("creeping_" + scene);
   const RunReport r = run_sphere_case(c, {dir, false, true, 0});
   ASSERT_EQ(r.outcome, RunOutcome::completed);
   const json& obs = r.result["observables"];
-  const double chi = 2 * c.radius_cells / c.box.nx;
-  const double expected = (1 - c.phi_realised) * calibration::sangani_acrivos_drag(chi);
+  const double chi = 2 * c.numerics.radius_cells / c.derived.box.nx;
+  const double expected = (1 - c.derived.phi_realised) * calibration::sangani_acrivos_drag(chi);
   const double F = obs["F"]["mean"].get<double>();
   const double re = obs["Re"]["mean"].get<double>();
   std::printf("%s: F = %.4f, (1 - phi) K_SA(%.3f) = %.4f, ratio %.4f, Re = %.4f\n", scene.c_str(),

@@ -44,8 +44,8 @@ TEST(PaperGrid, EveryPointParsesOrIsRefusedWithWhatWouldWork) {
     for (const auto& p : grid) {
       try {
         const cases::SuspensionCase c = cases::parse_suspension_case(p.case_json);
-        EXPECT_GE(c.viscosity, cases::smallest_stable_viscosity(c.radius_cells));
-        EXPECT_LE(c.settling_velocity, cases::kMaxSettlingVelocity);
+        EXPECT_GE(c.numerics.viscosity, cases::smallest_stable_viscosity(c.numerics.radius_cells));
+        EXPECT_LE(c.derived.settling_velocity, cases::kMaxSettlingVelocity);
       } catch (const input::InputError& e) {
         ++refused;
         refused_re.insert(p.case_json["Re_inf"].get<double>());

@@ -40,7 +40,7 @@ TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
   const RunReport a = run_sphere_case(c, {straight, false, true, 0});
   ASSERT_EQ(a.outcome, RunOutcome::completed);
   // stop inside stage 2 (after wells switched on: attached pairs are state)
-  const long stop = static_cast<long>(5.3 * c.convective_time);
+  const long stop = static_cast<long>(5.3 * c.derived.convective_time);
   ASSERT_EQ(run_sphere_case(c, {split, false, true, stop}).outcome, RunOutcome::interrupted);
   EXPECT_FALSE(fs::exists(split / "result.json"));
   const RunReport b = run_sphere_case(c, {split, true, true, 0});
@@ -53,7 +53,7 @@ TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
         .read<double>("/position");
   };
   const auto pa = read(straight), pb = read(split);
-  ASSERT_EQ(pa.size(), static_cast<std::size_t>(3 * c.sphere_count));
+  ASSERT_EQ(pa.size(), static_cast<std::size_t>(3 * c.derived.sphere_count));
   EXPECT_EQ(pa, pb);
   fs::remove_all(straight);
   fs::remove_all(split);
@@ -108,7 +108,7 @@ TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
   for (hsize_t row = 0; row < shape[0]; row += 7) {
     double row_mean = 0;
     for (hsize_t k = 0; k < shape[1]; ++k) row_mean += phi[row * shape[1] + k] / shape[1];
-    EXPECT_NEAR(row_mean, c.phi_realised, 1e-12) << "sample " << row;
+    EXPECT_NEAR(row_mean, c.derived.phi_realised, 1e-12) << "sample " << row;
   }
   fs::remove_all(dir);
 }
