@@ -10,27 +10,27 @@ namespace flocsim::run {
 
 namespace {
 
-Protocol::Durations durations_of(const cases::SuspensionCase& c) {
-  const double T = c.derived.convective_time;
+// `p`'s durations are in a / U_inf; `T` is a / U_inf in time steps.
+Protocol::Durations durations_of(const cases::Protocol& p, double T) {
   auto steps = [T](double in_convective_times) {
     return static_cast<long>(std::llround(in_convective_times * T));
   };
   Protocol::Durations d;
-  d.sample = std::max(1L, steps(c.protocol.sample_every));
-  d.stage1_min = steps(c.protocol.stage1_min);
-  d.stage1_max = steps(c.protocol.stage1_max);
-  d.settle = steps(c.protocol.stage2_settle);
-  d.statistics = std::max(d.sample, steps(c.protocol.statistics));
-  d.snapshot = c.protocol.snapshot_every > 0 ? std::max(1L, steps(c.protocol.snapshot_every)) : 0;
-  d.window_samples = std::max(5L, static_cast<long>(std::llround(c.protocol.stationarity_window /
-                                                                 c.protocol.sample_every)));
+  d.sample = std::max(1L, steps(p.sample_every));
+  d.stage1_min = steps(p.stage1_min);
+  d.stage1_max = steps(p.stage1_max);
+  d.settle = steps(p.stage2_settle);
+  d.statistics = std::max(d.sample, steps(p.statistics));
+  d.snapshot = p.snapshot_every > 0 ? std::max(1L, steps(p.snapshot_every)) : 0;
+  d.window_samples =
+      std::max(5L, static_cast<long>(std::llround(p.stationarity_window / p.sample_every)));
   return d;
 }
 
 }  // namespace
 
 Protocol::Protocol(const cases::SuspensionCase& c, const cases::SceneModules& modules)
-    : d_(durations_of(c)),
+    : d_(durations_of(c.protocol, c.derived.convective_time)),
       signal_(modules.liquid ? result_names::column::U_over_Uinf
                              : result_names::column::granular_temperature),
       convective_time_(c.derived.convective_time),
