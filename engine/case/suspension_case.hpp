@@ -36,9 +36,9 @@ inline constexpr double kDefaultSettlingVelocity = 0.02;
 // 7 at nu = 0.005).
 double smallest_stable_viscosity(double radius_cells);
 
-// The physical problem: the dimensionless groups of the paper's Table 1, the
-// domain's shape in radii, and the choices of contact and lubrication model.
-// The top-level fields of the case file.
+// The physical problem as the user states it: the dimensionless groups of the
+// paper's Table 1, the domain's shape in radii, and the lubrication model (the
+// case file's top-level numbers and model choices).
 struct Physics {
   double phi = 0.20;                            // requested solids fraction
   double reynolds_inf = 12;                     // Re_inf = U_inf 2a / nu
@@ -104,7 +104,7 @@ struct Derived {
   lattice::Extent box;            // cells: L x W x W
   int sphere_count = 0;           // N
   double phi_realised = 0;        // N (4/3) pi a^3 / V
-  double settling_velocity = 0;   // U_inf
+  double settling_velocity = 0;   // U_inf (numerics.U_inf when given)
   double drag_coefficient = 0;    // C_D (Schiller-Naumann at Re_inf)
   double gravity = 0;             // g
   double convective_time = 0;     // a / U_inf in time steps
