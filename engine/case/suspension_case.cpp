@@ -24,14 +24,19 @@ namespace {
 // is the paper's default case (a = 6 dx, L = 48a, L/W = 2); standard keeps
 // the resolution and shrinks the domain (the paper saw <= 4 % domain-size
 // effect on F); draft is for quick looks and CI.
+// Immersed boundary: draft and standard take the cheaper one-sweep option
+// (its drag on frozen random arrays at phi = 0.2 is the paper method's to
+// 0.01 %, within the paper's 1.5 % resolution tolerance; docs/accuracy-cost.md)
+// where it is validated, phi <= 0.2; paper keeps the paper's method.
 struct Preset {
   double radius_cells, length_over_a, stage1_min, stage1_max, stage2_settle, statistics;
   immersed_boundary::Scheme ib_scheme;
 };
 Preset preset(const std::string& fidelity) {
+  using immersed_boundary::kOneSweepScheme;
   using immersed_boundary::kPaperScheme;
-  if (fidelity == "draft") return {4, 16, 5, 20, 10, 20, kPaperScheme};
-  if (fidelity == "standard") return {6, 32, 20, 100, 50, 100, kPaperScheme};
+  if (fidelity == "draft") return {4, 16, 5, 20, 10, 20, kOneSweepScheme};
+  if (fidelity == "standard") return {6, 32, 20, 100, 50, 100, kOneSweepScheme};
   return {6, 48, 30, 150, 100, 300, kPaperScheme};  // paper
 }
 
@@ -192,7 +197,19 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     }
   }
   c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
-  c.numerics.ib_scheme = read_ib_scheme(num, p.ib_scheme);
+  {
+    // The preset's option where it is validated for this phi (a snapshot's phi
+    // is only known later: the paper's method then), else the paper's method.
+    // So does a case with the calibrated close-pair model where the option's
+    // close-pair resistance has not been measured at this a.
+    immersed_boundary::Scheme preset_scheme = p.ib_scheme;
+    if (!c.positions_from.empty() ||
+        c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
+        (c.physics.lubrication_model == "calibrated" &&
+         !calibration::PairResistanceTable::shipped().has(a, preset_scheme)))
+      preset_scheme = immersed_boundary::kPaperScheme;
+    c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
+  }
   c.numerics.input_radius_given = num.has("input_radius");
   if (c.numerics.input_radius_given)
     c.numerics.input_radius = num.number(
@@ -338,6 +355,19 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     throw InputError("phi = " + format_value(c.physics.phi) +
                      ": gives N = 0 spheres in this box; raise phi or L_over_a");
   c.derived.phi_realised = c.derived.sphere_count * sphere_volume / volume;
+  // The smallest phi that rounds to this N (a small box at phi = 0.2 holds
+  // 0.2015: rounding, not a denser suspension), for a snapshot's N too.
+  const double phi_asked = (c.derived.sphere_count - 0.5) * sphere_volume / volume;
+  if (modules_of(c.scene).liquid &&
+      phi_asked > immersed_boundary::largest_validated_phi(c.numerics.ib_scheme))
+    throw InputError(
+        "numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) + " with phi = " +
+        format_value(c.positions_from.empty() ? c.physics.phi : c.derived.phi_realised) +
+        ": this option is validated only up to phi = " +
+        format_value(immersed_boundary::largest_validated_phi(c.numerics.ib_scheme)) +
+        " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
+        "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
+        "(docs/accuracy-cost.md)");
   if (single) c.physics.phi = c.derived.phi_realised;
 
   c.derived.drag_coefficient = schiller_naumann_drag_coefficient(c.physics.reynolds_inf);

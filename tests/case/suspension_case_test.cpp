@@ -145,12 +145,17 @@ TEST(SuspensionCase, BadInputsAreNamed) {
 // interpolated in log nu, or from numerics.input_radius; an uncalibrated a is
 // refused before any work.
 TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
-  SuspensionCase c = parse_suspension_case(
-      {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"viscosity", 0.02}}}});
+  // the paper's method's entries (a = 6)
+  SuspensionCase c = parse_suspension_case({{"scene", "suspension"},
+                                            {"fidelity", "paper"},
+                                            {"phi", 0.2},
+                                            {"numerics", {{"viscosity", 0.02}}}});
   EXPECT_NEAR(c.numerics.input_radius, 5.5789, 1e-4);
   EXPECT_DOUBLE_EQ(c.numerics.calibration_viscosity, 0.02);
-  c = parse_suspension_case(
-      {{"scene", "single-sphere"}, {"Re_inf", 1}, {"numerics", {{"viscosity", 0.15}}}});  // 1/6
+  c = parse_suspension_case({{"scene", "single-sphere"},
+                             {"fidelity", "paper"},
+                             {"Re_inf", 1},
+                             {"numerics", {{"viscosity", 0.15}}}});  // 1/6
   // between the entries at nu = 0.08 (a_g 5.593528) and 1/6 (5.612012), by hand:
   // 5.593528 + ln(0.15 / 0.08) / ln((1/6) / 0.08) (5.612012 - 5.593528) = 5.609359
   EXPECT_NEAR(c.numerics.input_radius, 5.609359, 2e-6);
@@ -178,9 +183,10 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
 // calibration does not hold at this resolution refused with its fields and
 // the command that would calibrate it.
 TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
-  const SuspensionCase c = parse_suspension_case({{"scene", "suspension"}, {"phi", 0.2}});
-  EXPECT_EQ(c.numerics.ib_scheme, immersed_boundary::kPaperScheme);
-  EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"],
+  const SuspensionCase paper =
+      parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
+  EXPECT_EQ(paper.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_EQ(paper.to_json()["numerics"]["immersed_boundary"],
             json({{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}}));
   const json odd = {
       {"scene", "suspension"},
@@ -200,6 +206,27 @@ TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
                       {"phi", 0.2},
                       {"numerics", {{"immersed_boundary", {{"spacing", 1.0}}}}}};
   EXPECT_THAT(refusal(stray), AllOf(HasSubstr("spacing"), HasSubstr("marker_spacing")));
+}
+
+// draft and standard take the one-sweep option where it is validated
+// (phi <= 0.2) and the paper's method above; asking for one sweep above
+// phi = 0.2 is refused, naming the field, the value and the limit.
+TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
+  for (const char* fidelity : {"draft", "standard"}) {
+    SCOPED_TRACE(fidelity);
+    const SuspensionCase dilute =
+        parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.2}});
+    EXPECT_EQ(dilute.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+    const SuspensionCase dense =
+        parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.25}});
+    EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  }
+  const json asked = {
+      {"scene", "suspension"},
+      {"phi", 0.25},
+      {"numerics", {{"immersed_boundary", {{"marker_spacing", 1}, {"sweeps", 1}}}}}};
+  EXPECT_THAT(refusal(asked), AllOf(HasSubstr("numerics.immersed_boundary"), HasSubstr("sweeps 1"),
+                                    HasSubstr("phi = 0.25"), HasSubstr("up to phi = 0.2")));
 }
 
 // A fixed array from a snapshot: N and phi come from the file, which must hold

@@ -37,7 +37,8 @@ double array_error(double a, double phi, const immersed_boundary::Scheme& scheme
   std::printf(
       "%s, a = %g (a_g = %.4f) L = %3d phi = %.4f: K = %.4f  Sangani-Acrivos %.4f  error %+.2f "
       "%%\n",
-      scheme.describe().c_str(), a, ag, L, M_PI / 6 * chi * chi * chi, K, K_ref, 100 * (K / K_ref - 1));
+      scheme.describe().c_str(), a, ag, L, M_PI / 6 * chi * chi * chi, K, K_ref,
+      100 * (K / K_ref - 1));
   std::fflush(stdout);
   return K / K_ref - 1;
 }
@@ -46,6 +47,16 @@ double array_error(double a, double phi, const immersed_boundary::Scheme& scheme
 TEST(SimpleCubicArraySweep, Resolution6WithinTwoPercent) {
   for (double phi : {0.01, 0.05, 0.1, 0.2})
     EXPECT_LT(std::abs(array_error(6.0, phi)), 0.02) << "phi " << phi;
+}
+
+// The densest arrays, phi = 0.27 (3 dx between the spheres' surfaces at
+// a = 6, 4 dx at a = 8; at a = 4 the 10 dx cube cannot hold a sphere's kernel
+// cells apart from its own image), with the paper's method. (With markers
+// 1 dx apart and one sweep the overlap of neighbouring kernels is left
+// uncorrected and K falls 3.2-3.8 % short here, docs/accuracy-cost.md, so
+// cases refuse that option above phi = 0.2.)
+TEST(SimpleCubicArraySweep, DensestArraysPhi027) {
+  for (double a : {6.0, 8.0}) EXPECT_LT(std::abs(array_error(a, 0.27)), 0.02) << "a " << a;
 }
 
 // The error trend against resolution, reported; a = 4 and 8 dx are held to
@@ -254,11 +265,11 @@ using spheres::Vec3;
 using observables::beetstra_drag;
 
 // A static random array (random sequential addition, no overlap) of spheres
-// a = 4 dx (by default) in a (12a)^3 periodic box, nu = 0.02 (U = 0.025 at Re = 10), liquid driven by a body force
-// chosen from the correlation for the wanted Re; run to a steady state; F and Re measured and F
-// compared with Beetstra at the measured Re. Tolerance 15 %: the correlation's own scatter about
-// its data (~10 %, Beetstra et al.) plus the spread between single random configurations of ~100
-// spheres (a few %). Returns F.
+// a = 4 dx (by default) in a (12a)^3 periodic box, nu = 0.02 (U = 0.025 at Re = 10), liquid driven
+// by a body force chosen from the correlation for the wanted Re; run to a steady state; F and Re
+// measured and F compared with Beetstra at the measured Re. Tolerance 15 %: the correlation's own
+// scatter about its data (~10 %, Beetstra et al.) plus the spread between single random
+// configurations of ~100 spheres (a few %). Returns F.
 double static_random_array(double phi, double re_wanted, double nu = 0.02,
                            const immersed_boundary::Scheme& scheme = {}, double a = 4.0) {
   const int L = static_cast<int>(std::lround(12 * a));
@@ -344,14 +355,13 @@ std::vector<immersed_boundary::Scheme> offered_options() {
 
 class IbOption : public ::testing::TestWithParam<immersed_boundary::Scheme> {};
 
-// Sangani & Acrivos over phi = 0.01 - 0.27 at a = 6, 0.05 - 0.27 at a = 8
-// (0.01 would need a 60^3 box) and 0.01 - 0.2 at a = 4 (at 0.27 the cube,
-// 10 dx, is narrower than a sphere's kernel cells and their periodic image
-// allow): box sizes the calibration did not use, within 2 %.
+// Sangani & Acrivos over phi = 0.01 - 0.2 at a = 4 and 6, 0.05 - 0.2 at a = 8
+// (0.01 would need a 60^3 box): box sizes the calibration did not use,
+// within 2 %.
 TEST_P(IbOption, SimpleCubicArraysMatchSanganiAcrivos) {
   for (double a : {4.0, 6.0, 8.0})
-    for (double phi : {0.01, 0.05, 0.1, 0.2, 0.27}) {
-      if ((a == 8.0 && phi == 0.01) || (a == 4.0 && phi == 0.27)) continue;
+    for (double phi : {0.01, 0.05, 0.1, 0.2}) {
+      if (a == 8.0 && phi == 0.01) continue;
       EXPECT_LT(std::abs(array_error(a, phi, GetParam())), 0.02) << "a " << a << ", phi " << phi;
     }
 }
