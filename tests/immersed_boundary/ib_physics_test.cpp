@@ -70,7 +70,8 @@ void momentum_balance(double tolerance, const immersed_boundary::Scheme& scheme 
   // The spheres really settled (the test is not trivially satisfied).
   EXPECT_LT(s.velocity[0].x(), -1e-3);
   std::printf("momentum balance (%s, %s): max |P_total| = %.3e, sphere momentum %.3e, ratio %.3e\n",
-              sizeof(Real) == 8 ? "double" : "float", scheme.describe().c_str(), drift, scale, drift / scale);
+              sizeof(Real) == 8 ? "double" : "float", scheme.describe().c_str(), drift, scale,
+              drift / scale);
   EXPECT_LT(drift / scale, tolerance);
 }
 
