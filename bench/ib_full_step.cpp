@@ -15,6 +15,8 @@
 // Usage: bench_ib_full_step [--scale S] [--reps R] [--steps K] [--input-radius AG]
 //                           [--options K:S:N,...]
 //   --scale S shrinks the box to (48a x 24a x 24a) / S at the same phi.
+//   --phi PHI solids fraction (default 0.2): a dilute box checks the thread
+//   balance when few spheres share the colours.
 //   --options the schemes to time, each kernel:marker_spacing:sweeps
 //   (default roma3:0.7:2,roma3:1:1,linear2:1:1: the paper's method and the
 //   offered fast options). The cost hardly depends on a_g, so one input
@@ -98,7 +100,7 @@ struct OptionTimes {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double scale = 1, input_radius = 5.612;
+  double scale = 1, input_radius = 5.612, phi = 0.20;
   int reps = 5, steps = 4;
   std::string options_text =
       option_text(immersed_boundary::kPaperScheme) + ",roma3:1:1,linear2:1:1";
@@ -119,11 +121,13 @@ int main(int argc, char** argv) {
       input_radius = std::stod(v);
     else if (arg == "--options")
       options_text = v;
+    else if (arg == "--phi")
+      phi = std::stod(v);
     else {
       std::fprintf(
           stderr,
           "usage: bench_ib_full_step [--scale S] [--reps R] [--steps K] [--input-radius AG] "
-          "[--options kernel:spacing:sweeps,...]\n");
+          "[--options kernel:spacing:sweeps,...] [--phi PHI]\n");
       return 2;
     }
   }
@@ -142,7 +146,11 @@ int main(int argc, char** argv) {
     schemes.push_back(*scheme);
     at = comma + 1;
   }
-  const double a = 6.0, phi = 0.20, ratio = 4.0;
+  if (!(phi > 0 && phi <= 0.3)) {
+    std::fprintf(stderr, "bench_ib_full_step: --phi %g: must be in (0, 0.3]\n", phi);
+    return 2;
+  }
+  const double a = 6.0, ratio = 4.0;
   const int nx = static_cast<int>(std::lround(48 * a / scale));
   const int ny = static_cast<int>(std::lround(24 * a / scale));
   const spheres::PeriodicBox box{Vec3(nx, ny, ny)};
