@@ -199,13 +199,21 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
   {
     // The preset's option where it is validated for this phi (a snapshot's phi
-    // is only known later: the paper's method then), else the paper's method.
-    // So does a case with the calibrated close-pair model where the option's
-    // close-pair resistance has not been measured at this a.
+    // is only known later: the paper's method then) and calibrated for this a
+    // within a factor 2 of this viscosity, else the paper's method. So does a
+    // scene with the calibrated close-pair model where the option's close-pair
+    // resistance has not been measured at this a.
+    const auto& radii = calibration::CalibrationTable::shipped();
+    auto calibrated_near = [&](const immersed_boundary::Scheme& scheme) {
+      return radii.has(a, scheme) &&
+             std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
+                               c.numerics.viscosity)) <= std::log(2.0);
+    };
     immersed_boundary::Scheme preset_scheme = p.ib_scheme;
     if (!c.positions_from.empty() ||
         c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
-        (c.physics.lubrication_model == "calibrated" &&
+        !calibrated_near(preset_scheme) ||
+        (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
          !calibration::PairResistanceTable::shipped().has(a, preset_scheme)))
       preset_scheme = immersed_boundary::kPaperScheme;
     c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
@@ -260,6 +268,23 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
              : "raise numerics.U_inf to at least " +
                    format_value(nu_min * c.physics.reynolds_inf / (2 * a)) + " or leave it out"));
 
+  if (modules_of(c.scene).liquid && c.numerics.input_radius_given) {
+    // A hand-given a_g replaces the calibration, not the validation: the
+    // scheme must still be one the project offers (calibrated at some a).
+    const auto& table = calibration::CalibrationTable::shipped();
+    bool offered = false;
+    std::string names;
+    for (const auto& e : table.entries()) {
+      offered = offered || e.scheme == c.numerics.ib_scheme;
+      const std::string n = scheme_fields(e.scheme);
+      if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
+    }
+    if (!offered)
+      throw InputError("numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) +
+                       ": not an offered option (no calibration of it is shipped at any a); "
+                       "offered: " +
+                       names + " (docs/accuracy-cost.md)");
+  }
   if (modules_of(c.scene).liquid && !c.numerics.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one

@@ -4,7 +4,8 @@
 // step makes and which interpolation/spreading kernel couples them to the
 // lattice. Each combination changes the hydrodynamic radius and the lattice's
 // own close-pair resistance, so a run accepts only a scheme that the shipped
-// calibration tables hold for its resolution (engine/calibration).
+// calibration tables hold for its resolution (with a hand-given input radius,
+// at some resolution) (engine/calibration).
 #include <cmath>
 #include <cstdio>
 #include <optional>

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "engine/case/scene.hpp"
+#include "engine/immersed_boundary/scheme.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 
@@ -176,6 +177,19 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
     }
     if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
       c["run"].erase("steps");
+    // Checkpoints from before numerics.immersed_boundary existed were run with
+    // the paper's method, the only one there was.
+    if (c.contains("numerics") && c["numerics"].is_object() &&
+        c["numerics"].contains("a_over_dx") &&
+        c.value("scene", "") != cases::scene_name(cases::Scene::granular) &&
+        c.value("scene", "") != cases::scene_name(cases::Scene::fluid) &&
+        !c["numerics"].contains("immersed_boundary")) {
+      const auto& paper = immersed_boundary::kPaperScheme;
+      c["numerics"]["immersed_boundary"] = {
+          {"marker_spacing", paper.marker_spacing},
+          {"sweeps", paper.sweeps},
+          {"kernel", immersed_boundary::kernel_name(paper.kernel)}};
+    }
     return c;
   };
   return physics_only(checkpoint_case) == physics_only(current_case);

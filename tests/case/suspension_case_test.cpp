@@ -221,6 +221,21 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
         parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.25}});
     EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   }
+  // where the option is not calibrated near the case's a and viscosity (a = 12
+  // has no one-sweep entry; a = 8 has one only at nu = 1/6, 6x away from 0.027)
+  const SuspensionCase fine = parse_suspension_case(
+      {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 12}}}});
+  EXPECT_EQ(fine.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  // a hand-given a_g does not let in a scheme that is not offered
+  const json linear = {
+      {"scene", "suspension"},
+      {"phi", 0.2},
+      {"numerics",
+       {{"input_radius", 5.7},
+        {"immersed_boundary", {{"marker_spacing", 1}, {"sweeps", 1}, {"kernel", "linear2"}}}}}};
+  EXPECT_THAT(refusal(linear),
+              AllOf(HasSubstr("numerics.immersed_boundary"), HasSubstr("kernel linear2"),
+                    HasSubstr("not an offered"), HasSubstr("kernel roma3")));
   const json asked = {
       {"scene", "suspension"},
       {"phi", 0.25},

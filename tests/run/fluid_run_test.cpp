@@ -17,6 +17,7 @@
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/process/stop_signal.hpp"
+#include "engine/run/output_directory.hpp"
 #include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
@@ -217,6 +218,23 @@ std::string text_of(const fs::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// A checkpoint from before numerics.immersed_boundary existed was run with the
+// paper's method: it resumes under a case that names that method, and not
+// under one that asks for another.
+TEST(OutputDirectory, CheckpointsWithoutAnImmersedBoundaryFieldWereThePaperMethod) {
+  const json old_case = {
+      {"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 4}, {"viscosity", 0.02}}}};
+  json paper = old_case;
+  paper["numerics"]["immersed_boundary"] = {
+      {"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}};
+  json one_sweep = old_case;
+  one_sweep["numerics"]["immersed_boundary"] = {
+      {"marker_spacing", 1.0}, {"sweeps", 1}, {"kernel", "roma3"}};
+  EXPECT_TRUE(resumable_under(old_case, paper));
+  EXPECT_FALSE(resumable_under(old_case, one_sweep));
+  EXPECT_FALSE(resumable_under(paper, one_sweep));
 }
 
 TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
