@@ -446,10 +446,7 @@ nlohmann::json SuspensionCase::to_json() const {
                    {"viscosity", numerics.viscosity},
                    {"trt_magic", numerics.trt_magic}};
   if (modules_of(scene).liquid)
-    j["numerics"]["immersed_boundary"] = {
-        {"marker_spacing", numerics.ib_scheme.marker_spacing},
-        {"sweeps", numerics.ib_scheme.sweeps},
-        {"kernel", immersed_boundary::kernel_name(numerics.ib_scheme.kernel)}};
+    j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.ib_scheme);
   if (numerics.input_radius_given) j["numerics"]["input_radius"] = numerics.input_radius;
   j["protocol"] = {{"stage1_min", protocol.stage1_min},
                    {"stage1_max", protocol.stage1_max},
@@ -487,6 +484,12 @@ nlohmann::json SuspensionCase::derived_json() const {
           {"Mach_U_inf", derived.settling_velocity * std::sqrt(3.0)},
           {"input_radius", numerics.input_radius},
           {"input_radius_from", input_radius_from}};
+}
+
+nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme) {
+  return {{"marker_spacing", scheme.marker_spacing},
+          {"sweeps", scheme.sweeps},
+          {"kernel", immersed_boundary::kernel_name(scheme.kernel)}};
 }
 
 }  // namespace flocsim::cases

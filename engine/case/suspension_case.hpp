@@ -139,6 +139,9 @@ struct SuspensionCase {
 // names the field, the value and the allowed range.
 SuspensionCase parse_suspension_case(const nlohmann::json& document);
 
+// numerics.immersed_boundary as a case file writes it: {marker_spacing, sweeps, kernel}.
+nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme);
+
 // Schiller-Naumann: C_D = 24/Re (1 + 0.15 Re^0.687).
 double schiller_naumann_drag_coefficient(double reynolds);
 

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "engine/case/scene.hpp"
+#include "engine/case/suspension_case.hpp"
 #include "engine/immersed_boundary/scheme.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
@@ -184,11 +185,8 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
         c.value("scene", "") != cases::scene_name(cases::Scene::granular) &&
         c.value("scene", "") != cases::scene_name(cases::Scene::fluid) &&
         !c["numerics"].contains("immersed_boundary")) {
-      const auto& paper = immersed_boundary::kPaperScheme;
-      c["numerics"]["immersed_boundary"] = {
-          {"marker_spacing", paper.marker_spacing},
-          {"sweeps", paper.sweeps},
-          {"kernel", immersed_boundary::kernel_name(paper.kernel)}};
+      c["numerics"]["immersed_boundary"] =
+          cases::immersed_boundary_json(immersed_boundary::kPaperScheme);
     }
     return c;
   };
