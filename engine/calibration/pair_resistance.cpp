@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -237,8 +238,12 @@ std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
       one << " a = " << e.hydrodynamic_radius << " (" << e.scheme.describe() << ")";
       if (std::find(seen.begin(), seen.end(), one.str()) == seen.end()) seen.push_back(one.str());
     }
-    for (const auto& one : seen) msg << one;
-    msg << ". Run `flocsim calibrate --close-pairs`, or set lubrication_model to nguyen-ladd.";
+    for (std::size_t k = 0; k < seen.size(); ++k) msg << (k ? "," : "") << seen[k];
+    msg << ". Run `flocsim calibrate --close-pairs --radius " << a << " --viscosity " << nu
+        << " --marker-spacing " << scheme.marker_spacing << " --sweeps " << scheme.sweeps
+        << " --kernel " << immersed_boundary::kernel_name(scheme.kernel)
+        << " --table engine/calibration/pair_resistance.json` and rebuild, or set "
+           "lubrication_model to nguyen-ladd.";
     throw std::out_of_range(msg.str());
   }
   if (!below) below = above;
@@ -252,6 +257,21 @@ std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
     share.emplace_back(p.gap_over_a, lo + f * (hi - lo));
   }
   return share;
+}
+
+double PairResistanceTable::viscosity_gap(double a, double nu,
+                                          const immersed_boundary::Scheme& scheme) const {
+  double below = 0, above = std::numeric_limits<double>::infinity();
+  bool any = false;
+  for (const auto& e : entries_) {
+    if (!same_scheme(e, a, scheme)) continue;
+    any = true;
+    if (e.viscosity <= nu) below = std::max(below, e.viscosity);
+    if (e.viscosity >= nu) above = std::min(above, e.viscosity);
+  }
+  if (!any) return std::numeric_limits<double>::infinity();
+  if (below > 0 && std::isfinite(above)) return 1.0;
+  return below > 0 ? nu / below : above / nu;
 }
 
 }  // namespace flocsim::calibration

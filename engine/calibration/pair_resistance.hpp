@@ -87,6 +87,10 @@ class PairResistanceTable {
   std::vector<std::pair<double, double>> lattice_share(
       double hydrodynamic_radius, double viscosity,
       const immersed_boundary::Scheme& scheme = {}) const;
+  // How far viscosity lies outside the calibrated ones for this a and scheme,
+  // as a factor >= 1 (1 when two entries bracket it); infinity without entry.
+  double viscosity_gap(double hydrodynamic_radius, double viscosity,
+                       const immersed_boundary::Scheme& scheme = {}) const;
   std::string note;
 
  private:

@@ -153,7 +153,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.physics.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
   c.physics.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
   c.physics.lubrication_model =
-      root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "nguyen-ladd");
+      root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "calibrated");
   c.physics.lubrication_integration =
       root.choice("lubrication_integration", {"implicit", "explicit-paper"}, "implicit");
   c.physics.lubrication_onset_over_a =
@@ -202,7 +202,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // is only known later: the paper's method then) and calibrated for this a
     // within a factor 2 of this viscosity, else the paper's method. So does a
     // scene with the calibrated close-pair model where the option's close-pair
-    // resistance has not been measured at this a.
+    // resistance has not been measured at this a within a factor 2 of nu.
     const auto& radii = calibration::CalibrationTable::shipped();
     auto calibrated_near = [&](const immersed_boundary::Scheme& scheme) {
       return radii.has(a, scheme) &&
@@ -214,7 +214,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
         c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
         !calibrated_near(preset_scheme) ||
         (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
-         !calibration::PairResistanceTable::shipped().has(a, preset_scheme)))
+         calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
+                                                                   preset_scheme) > 2.0))
       preset_scheme = immersed_boundary::kPaperScheme;
     c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
   }
@@ -324,6 +325,13 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
                        format_value(a) + ": " + e.what());
     }
+    const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.ib_scheme);
+    if (gap > 2.0)
+      c.warnings.push_back("the close-pair calibration nearest to viscosity = " +
+                           format_value(c.numerics.viscosity) + " at a_over_dx = " +
+                           format_value(a) + " lies a factor " + format_value(gap) +
+                           " away; `flocsim calibrate --close-pairs --viscosity` makes one for "
+                           "this viscosity");
     if (c.numerics.input_radius_given)
       c.warnings.push_back(
           "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <ctime>
 #include <fstream>
+#include <set>
 
 #include "engine/case/scene.hpp"
 #include "engine/case/suspension_case.hpp"
@@ -119,7 +120,9 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
     }
     if (!resumable_under(recorded, case_json))
       throw input::InputError(dir.string() + " holds the output of a different case (" +
-                              record.string() + "); use another --out directory");
+                              record.string() + ": " + case_differences(recorded, case_json) +
+                              "); use another --out directory, or give those fields their "
+                              "recorded values to continue it");
     same_case = true;
   }
   if (same_case)
@@ -169,28 +172,62 @@ std::string utc_timestamp() {
   return buf;
 }
 
+namespace {
+// The case with run control removed and the defaults of older checkpoints
+// filled in, as resumable_under compares it.
+nlohmann::json physics_only(nlohmann::json c) {
+  for (const char* group : {"run", "protocol"}) {
+    if (!c.contains(group)) continue;
+    for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
+      c[group].erase(key);
+  }
+  if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
+    c["run"].erase("steps");
+  // Checkpoints from before numerics.immersed_boundary existed were run with
+  // the paper's method, the only one there was.
+  if (c.contains("numerics") && c["numerics"].is_object() && c["numerics"].contains("a_over_dx") &&
+      c.value("scene", "") != cases::scene_name(cases::Scene::granular) &&
+      c.value("scene", "") != cases::scene_name(cases::Scene::fluid) &&
+      !c["numerics"].contains("immersed_boundary")) {
+    c["numerics"]["immersed_boundary"] =
+        cases::immersed_boundary_json(immersed_boundary::kPaperScheme);
+  }
+  // Checkpoints from before lubrication_model existed used Nguyen-Ladd's
+  // correction, the only one there was.
+  if (c.value("scene", "") == cases::scene_name(cases::Scene::suspension) &&
+      !c.contains("lubrication_model"))
+    c["lubrication_model"] = "nguyen-ladd";
+  return c;
+}
+
+void list_differences(const nlohmann::json& was, const nlohmann::json& now,
+                      const std::string& prefix, std::vector<std::string>& out) {
+  std::set<std::string> keys;
+  for (const auto& [k, v] : was.items()) keys.insert(k);
+  for (const auto& [k, v] : now.items()) keys.insert(k);
+  for (const auto& k : keys) {
+    const bool in_was = was.contains(k), in_now = now.contains(k);
+    if (in_was && in_now && was[k].is_object() && now[k].is_object()) {
+      list_differences(was[k], now[k], prefix + k + ".", out);
+    } else if (!in_was || !in_now || was[k] != now[k]) {
+      out.push_back(prefix + k + " = " + (in_was ? was[k].dump() : "(absent)") +
+                    " in the checkpoint, " + (in_now ? now[k].dump() : "(absent)") + " now");
+    }
+  }
+}
+}  // namespace
+
 bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json& current_case) {
-  auto physics_only = [](nlohmann::json c) {
-    for (const char* group : {"run", "protocol"}) {
-      if (!c.contains(group)) continue;
-      for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
-        c[group].erase(key);
-    }
-    if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
-      c["run"].erase("steps");
-    // Checkpoints from before numerics.immersed_boundary existed were run with
-    // the paper's method, the only one there was.
-    if (c.contains("numerics") && c["numerics"].is_object() &&
-        c["numerics"].contains("a_over_dx") &&
-        c.value("scene", "") != cases::scene_name(cases::Scene::granular) &&
-        c.value("scene", "") != cases::scene_name(cases::Scene::fluid) &&
-        !c["numerics"].contains("immersed_boundary")) {
-      c["numerics"]["immersed_boundary"] =
-          cases::immersed_boundary_json(immersed_boundary::kPaperScheme);
-    }
-    return c;
-  };
   return physics_only(checkpoint_case) == physics_only(current_case);
+}
+
+std::string case_differences(const nlohmann::json& checkpoint_case,
+                             const nlohmann::json& current_case) {
+  std::vector<std::string> lines;
+  list_differences(physics_only(checkpoint_case), physics_only(current_case), "", lines);
+  std::string text;
+  for (const auto& l : lines) text += (text.empty() ? "" : "; ") + l;
+  return text;
 }
 
 RunReport blown_up_run(RunLog& log, const std::string& where, const std::string& what,

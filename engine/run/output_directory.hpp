@@ -53,5 +53,9 @@ std::string utc_timestamp();
 // control (threads, progress and checkpoint cadence; for the fluid scene the
 // total number of steps, to extend a run). Everything else must match.
 bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json& current_case);
+// What keeps a checkpoint from being continued: "field = old in the
+// checkpoint, new now" for each differing field, joined by "; ".
+std::string case_differences(const nlohmann::json& checkpoint_case,
+                             const nlohmann::json& current_case);
 
 }  // namespace flocsim::run

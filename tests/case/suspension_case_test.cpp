@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "engine/calibration/pair_resistance.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/sphere_snapshots.hpp"
@@ -94,9 +95,11 @@ TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
 }
 
 TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
+  // (a = 8 has no close-pair calibration: Nguyen-Ladd's correction, by name)
   const SuspensionCase c = parse_suspension_case({{"scene", "suspension"},
                                                   {"fidelity", "draft"},
                                                   {"phi", 0.2},
+                                                  {"lubrication_model", "nguyen-ladd"},
                                                   {"numerics", {{"a_over_dx", 8}}}});
   EXPECT_EQ(c.numerics.radius_cells, 8);
   EXPECT_EQ(c.derived.box.nx, 16 * 8);  // draft domain L = 16a with the explicit a
@@ -212,19 +215,27 @@ TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
 // (phi <= 0.2) and the paper's method above; asking for one sweep above
 // phi = 0.2 is refused, naming the field, the value and the limit.
 TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
+  // The immersed-boundary side alone (Nguyen-Ladd's correction needs no
+  // close-pair calibration; the calibrated default is tested below).
   for (const char* fidelity : {"draft", "standard"}) {
     SCOPED_TRACE(fidelity);
-    const SuspensionCase dilute =
-        parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.2}});
+    const SuspensionCase dilute = parse_suspension_case({{"scene", "suspension"},
+                                                         {"fidelity", fidelity},
+                                                         {"lubrication_model", "nguyen-ladd"},
+                                                         {"phi", 0.2}});
     EXPECT_EQ(dilute.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-    const SuspensionCase dense =
-        parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.25}});
+    const SuspensionCase dense = parse_suspension_case({{"scene", "suspension"},
+                                                        {"fidelity", fidelity},
+                                                        {"lubrication_model", "nguyen-ladd"},
+                                                        {"phi", 0.25}});
     EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   }
   // where the option is not calibrated near the case's a and viscosity (a = 12
   // has no one-sweep entry; a = 8 has one only at nu = 1/6, 6x away from 0.027)
-  const SuspensionCase fine = parse_suspension_case(
-      {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 12}}}});
+  const SuspensionCase fine = parse_suspension_case({{"scene", "suspension"},
+                                                     {"phi", 0.2},
+                                                     {"lubrication_model", "nguyen-ladd"},
+                                                     {"numerics", {{"a_over_dx", 12}}}});
   EXPECT_EQ(fine.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   // a hand-given a_g does not let in a scheme that is not offered
   const json linear = {
@@ -239,9 +250,57 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
   const json asked = {
       {"scene", "suspension"},
       {"phi", 0.25},
+      {"lubrication_model", "nguyen-ladd"},
       {"numerics", {{"immersed_boundary", {{"marker_spacing", 1}, {"sweeps", 1}}}}}};
   EXPECT_THAT(refusal(asked), AllOf(HasSubstr("numerics.immersed_boundary"), HasSubstr("sweeps 1"),
                                     HasSubstr("phi = 0.25"), HasSubstr("up to phi = 0.2")));
+}
+
+// Lubrication is the calibrated close-pair model unless the case names
+// Nguyen-Ladd's: it needs the lattice's measured share at the case's a and IB
+// scheme (engine/calibration/pair_resistance.json), and a case without one is
+// refused before any work, naming both ways out. The presets take the
+// one-sweep option only where its close pairs are calibrated within a factor
+// 2 of the case's viscosity, else the paper's method.
+TEST(SuspensionCase, CalibratedClosePairsByDefault) {
+  using calibration::PairResistanceTable;
+  const auto& pairs = PairResistanceTable::shipped();
+  for (const char* fidelity : {"draft", "standard", "paper"}) {
+    SCOPED_TRACE(fidelity);
+    const SuspensionCase c =
+        parse_suspension_case({{"scene", "suspension"}, {"fidelity", fidelity}, {"phi", 0.2}});
+    EXPECT_EQ(c.physics.lubrication_model, "calibrated");
+    EXPECT_FALSE(c.numerics.lubrication_lattice_share.empty());
+    const double a = c.numerics.radius_cells, nu = c.numerics.viscosity;
+    const bool one_sweep_pairs =
+        pairs.viscosity_gap(a, nu, immersed_boundary::kOneSweepScheme) <= 2.0;
+    EXPECT_EQ(c.numerics.ib_scheme, std::string(fidelity) != "paper" && one_sweep_pairs
+                                        ? immersed_boundary::kOneSweepScheme
+                                        : immersed_boundary::kPaperScheme);
+    EXPECT_LE(pairs.viscosity_gap(a, nu, c.numerics.ib_scheme), 2.0);
+  }
+  // the paper's viscosities at a = 6 are calibrated for the paper's method
+  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, immersed_boundary::kPaperScheme), 1.0);
+  // a = 8: no close-pair entry; refused with the field, the command and the way out
+  EXPECT_THAT(
+      refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}),
+      AllOf(HasSubstr("lubrication_model = \"calibrated\""), HasSubstr("numerics.a_over_dx = 8"),
+            HasSubstr("flocsim calibrate --close-pairs"), HasSubstr("nguyen-ladd")));
+  // scenes without lubrication need no close-pair entry
+  EXPECT_NO_THROW(parse_suspension_case(
+      {{"scene", "fixed-array"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}));
+  // far from the calibrated viscosities: accepted with a warning naming the gap
+  // (a = 6 entries at nu = 0.02 and 0.04; nu = 0.1 is 2.5x above)
+  const SuspensionCase far = parse_suspension_case({{"scene", "suspension"},
+                                                    {"fidelity", "paper"},
+                                                    {"phi", 0.2},
+                                                    {"Re_inf", 3},
+                                                    {"numerics", {{"viscosity", 0.1}}}});
+  bool warned = false;
+  for (const auto& w : far.warnings)
+    warned =
+        warned || w.find("close-pair calibration nearest to viscosity = 0.1") != std::string::npos;
+  EXPECT_TRUE(warned);
 }
 
 // A fixed array from a snapshot: N and phi come from the file, which must hold

@@ -1,11 +1,15 @@
-// The close-pair calibration at the paper's viscosities and at a = 6 (slow:
-// low viscosities take long to reach a steady flow). docs/contacts.md.
+// The close-pair calibration at the paper's viscosities, at a = 6 and for the
+// one-sweep immersed-boundary option (slow: low viscosities take long to reach
+// a steady flow). Each measures again in a box the calibration did not use
+// (20a at a = 4, where it used 16a; 14a at a = 6, where it used 12a) and at
+// gaps and viscosities between the calibrated ones. docs/contacts.md.
 #include "tests/lubrication/close_pair_total.hpp"
 
 namespace flocsim::lubrication {
 namespace {
 
 const std::vector<double> kGaps = {0.01, 0.015, 0.03, 0.07, 0.12, 0.2};
+const std::vector<double> kFewGaps = {0.01, 0.03, 0.07, 0.2};
 
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4PaperViscosity) {
   expect_total_near_brenner(4, 0.02, kGaps);
@@ -16,7 +20,15 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4LowViscosity) {
 }
 
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6) {
-  expect_total_near_brenner(6, 0.03, kGaps);
+  expect_total_near_brenner(6, 0.03, kFewGaps, 14);
+}
+
+TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA4) {
+  expect_total_near_brenner(4, 0.03, kFewGaps, 20, immersed_boundary::kOneSweepScheme, "standard");
+}
+
+TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6) {
+  expect_total_near_brenner(6, 0.03, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
 }
 
 }  // namespace

@@ -237,6 +237,30 @@ TEST(OutputDirectory, CheckpointsWithoutAnImmersedBoundaryFieldWereThePaperMetho
   EXPECT_FALSE(resumable_under(paper, one_sweep));
 }
 
+// A checkpoint from before lubrication_model existed used Nguyen-Ladd's
+// correction: it resumes under a case that says so, and the refusal under the
+// calibrated model names the field and both values.
+TEST(OutputDirectory, CheckpointsWithoutALubricationModelWereNguyenLadd) {
+  const json old_case = {
+      {"scene", "suspension"},
+      {"phi", 0.2},
+      {"numerics",
+       {{"a_over_dx", 4},
+        {"immersed_boundary", {{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}}}}}};
+  json nguyen_ladd = old_case;
+  nguyen_ladd["lubrication_model"] = "nguyen-ladd";
+  json calibrated = old_case;
+  calibrated["lubrication_model"] = "calibrated";
+  EXPECT_TRUE(resumable_under(old_case, nguyen_ladd));
+  EXPECT_FALSE(resumable_under(old_case, calibrated));
+  EXPECT_EQ(case_differences(old_case, calibrated),
+            "lubrication_model = \"nguyen-ladd\" in the checkpoint, \"calibrated\" now");
+  json other = nguyen_ladd;
+  other["numerics"]["a_over_dx"] = 6;
+  EXPECT_EQ(case_differences(nguyen_ladd, other),
+            "numerics.a_over_dx = 4 in the checkpoint, 6 now");
+}
+
 TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
   // The reproducer of the report: a folder holding the user's spheres/mine.txt
   // and a file called `fields`; the fresh run removed both and exited 0.
