@@ -92,6 +92,13 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
             u.window_start = obs["window"].value("start", 0.0);
             u.window_end = obs["window"].value("end", 0.0);
           }
+          if (res.contains("case") && res["case"].is_object()) {
+            const json& rc = res["case"];
+            u.resolved_models =
+                "lubrication_model " + rc.value("lubrication_model", std::string("nguyen-ladd")) +
+                ", immersed boundary " +
+                rc.value("numerics", json::object()).value("immersed_boundary", json()).dump();
+          }
           u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
           if (u.phi == 0) u.phi = res.value("derived", json::object()).value("phi_realised", 0.0);
         }
@@ -134,12 +141,21 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
     row.run = &r;
     const auto it = zero_du.find(baseline_key(r.case_json));
     const RunSummary* base = it == zero_du.end() ? nullptr : it->second.front();
+    // The same input case may have resolved to other models under another
+    // version (a changed default): such a pair is not a ratio of one model.
+    const bool other_models = base && !r.resolved_models.empty() &&
+                              !base->resolved_models.empty() &&
+                              r.resolved_models != base->resolved_models;
     if (r.status != db::RunState::kCompleted || !r.F || !r.n_a) {
       row.reason = "this run is " + to_string(r.status) + (r.has_result ? " (no F or <n_a>)" : "");
     } else if (!base) {
       row.reason =
           "no du = 0 run of the same case (same phi, Re_inf, fidelity, numerics, box, seed and "
           "protocol) in the database";
+    } else if (other_models) {
+      row.reason = "its du = 0 run " + base->id.substr(0, 12) + " ran with " +
+                   base->resolved_models + ", this one with " + r.resolved_models +
+                   " (defaults of different flocsim versions); name them in the sweep's base";
     } else if (base->status != db::RunState::kCompleted || !base->F || !base->n_a) {
       row.reason = "its baseline " + base->id.substr(0, 12) + " is " + to_string(base->status);
     } else {

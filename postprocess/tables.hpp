@@ -44,6 +44,10 @@ struct RunSummary {
   double phi = 0, re_inf = 0, du = 0;
   std::optional<double> wall_s;
   std::string flocsim_version, fidelity;
+  // The models the run resolved (result.json's case: lubrication model and
+  // immersed-boundary scheme), which the input case may leave to defaults
+  // that changed between versions; empty without a result.
+  std::string resolved_models;
 };
 
 // The runs of the database (of one sweep when given), filtered like `flocsim

@@ -328,10 +328,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.ib_scheme);
     if (gap > 2.0)
       c.warnings.push_back("the close-pair calibration nearest to viscosity = " +
-                           format_value(c.numerics.viscosity) + " at a_over_dx = " +
-                           format_value(a) + " lies a factor " + format_value(gap) +
-                           " away; `flocsim calibrate --close-pairs --viscosity` makes one for "
-                           "this viscosity");
+                           format_value(c.numerics.viscosity) +
+                           " at a_over_dx = " + format_value(a) + " lies a factor " +
+                           format_value(gap) + " away; `flocsim calibrate --close-pairs --radius " +
+                           format_value(a) + " --viscosity " + format_value(c.numerics.viscosity) +
+                           " --table engine/calibration/pair_resistance.json` (with the "
+                           "scheme's --marker-spacing, --sweeps, --kernel) makes one");
     if (c.numerics.input_radius_given)
       c.warnings.push_back(
           "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +

@@ -193,9 +193,15 @@ nlohmann::json physics_only(nlohmann::json c) {
         cases::immersed_boundary_json(immersed_boundary::kPaperScheme);
   }
   // Checkpoints from before lubrication_model existed used Nguyen-Ladd's
-  // correction, the only one there was.
-  if (c.value("scene", "") == cases::scene_name(cases::Scene::suspension) &&
-      !c.contains("lubrication_model"))
+  // correction, the only one there was. Scenes without lubrication carry the
+  // field (with whatever default their version had) but do not use it, so it
+  // does not decide whether they resume.
+  bool lubricated = false;
+  for (const auto& entry : cases::kScenes)
+    if (c.value("scene", "") == entry.name) lubricated = entry.modules.lubrication;
+  if (!lubricated)
+    c.erase("lubrication_model");
+  else if (!c.contains("lubrication_model"))
     c["lubrication_model"] = "nguyen-ladd";
   return c;
 }

@@ -27,6 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 struct HandRun {
@@ -34,6 +35,7 @@ struct HandRun {
   json case_json;
   std::string state;  // completed | failed | running | pending
   double F = 0, F_err = 0, n_a = 0, n_a_err = 0;
+  std::string lubrication_model;  // as the run resolved it (result.json's case); "" for none
 };
 
 json suspension(double du, double re_inf = 12, double a = 4) {
@@ -90,10 +92,14 @@ class Post : public ::testing::Test {
       json obs = {{"F", {{"mean", r.F}, {"error", r.F_err}, {"error_reliable", true}}},
                   {"n_a_mean", {{"mean", r.n_a}, {"error", r.n_a_err}, {"error_reliable", true}}},
                   {"window", {{"start", 100}, {"end", 400}}}};
-      rec.result_json = json{{"observables", obs},
-                             {"not_stationary", json::array()},
-                             {"derived", {{"sphere_count", 49}}}}
-                            .dump();
+      json result = {{"observables", obs},
+                     {"not_stationary", json::array()},
+                     {"derived", {{"sphere_count", 49}}}};
+      if (!r.lubrication_model.empty()) {
+        result["case"] = r.case_json;
+        result["case"]["lubrication_model"] = r.lubrication_model;
+      }
+      rec.result_json = result.dump();
       rec.observables = {{"F", r.F, r.F_err}, {"n_a_mean", r.n_a, r.n_a_err}, {"Re", 4.0, 0.1},
                          {"Re_T", 1.0, 0.05}, {"U_over_Uinf", 0.3, 0.01},     {"C_sph", 1.0, 0.1}};
       db.record_result(claim->attempt_id, rec);
@@ -172,6 +178,29 @@ TEST_F(Post, ABaselineThatLeavesDuAtItsDefaultIsFound) {
   const auto rows = aggregation_table(load_runs(db, std::nullopt, {}));
   ASSERT_EQ(rows.size(), 1u);
   ASSERT_NE(rows[0].baseline, nullptr) << rows[0].reason;
+}
+
+// The same input case resolved to another lubrication model under another
+// version (the default changed): F/F0 would mix two models, so no pairing.
+TEST_F(Post, NoBaselineAcrossResolvedModels) {
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1, "nguyen-ladd"},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4, "calibrated"},
+                {"agg2", suspension(0.03), "completed", 2.8, 0.09, 12.0, 0.4, "nguyen-ladd"}});
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  const auto rows = aggregation_table(runs);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& r : rows) {
+    if (r.run->id == "agg") {
+      EXPECT_EQ(r.baseline, nullptr);
+      EXPECT_THAT(r.reason, AllOf(HasSubstr("lubrication_model nguyen-ladd"),
+                                  HasSubstr("lubrication_model calibrated")));
+    } else {
+      ASSERT_NE(r.baseline, nullptr) << r.reason;  // same model: paired
+      EXPECT_NEAR(r.F_over_F0->mean, 2.8 / 4.0, 1e-12);
+    }
+  }
 }
 
 TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {

@@ -259,6 +259,10 @@ TEST(OutputDirectory, CheckpointsWithoutALubricationModelWereNguyenLadd) {
   other["numerics"]["a_over_dx"] = 6;
   EXPECT_EQ(case_differences(nguyen_ladd, other),
             "numerics.a_over_dx = 4 in the checkpoint, 6 now");
+  // a scene without lubrication resumes whatever default its version wrote
+  json fixed_old = nguyen_ladd, fixed_now = calibrated;
+  fixed_old["scene"] = fixed_now["scene"] = "fixed-array";
+  EXPECT_TRUE(resumable_under(fixed_old, fixed_now));
 }
 
 TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
