@@ -107,7 +107,7 @@ double integrated_correlation_time(const std::vector<double>& series) {
   return tau;
 }
 
-Drift window_drift(const std::vector<double>& series, double z_limit) {
+Drift window_drift(const std::vector<double>& series, double z_limit, double relative_floor) {
   Drift out;
   const std::size_t n = series.size();
   if (n < 3) return out;
@@ -136,7 +136,8 @@ Drift window_drift(const std::vector<double>& series, double z_limit) {
     const double se = std::sqrt(variance * integrated_correlation_time(residual) / s_tt);
     out.z = slope / se;
   }
-  out.stationary = std::abs(out.z) <= z_limit;
+  out.stationary =
+      std::abs(out.z) <= z_limit || std::abs(out.change) <= relative_floor * std::abs(x_mean);
   return out;
 }
 

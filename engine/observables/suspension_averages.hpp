@@ -50,13 +50,19 @@ double integrated_correlation_time(const std::vector<double>& series);
 // (a rising <n_a> gives a tidy mean and a small error). The least-squares
 // slope b of the series against the sample index, with its standard error
 // widened by the residuals' integrated correlation time tau (an AR(1) series
-// has var(b) ~ tau sigma^2 / S_tt), gives z = b / se(b); |z| > 3 is a trend.
+// has var(b) ~ tau sigma^2 / S_tt), gives z = b / se(b); |z| > 3 is a trend,
+// unless the change over the window is below `relative_floor` of the mean:
+// a deterministic flow still converging by 1e-7 (a fixed array's drag over
+// its last 10 a/U_inf, float) has almost no noise, so any slope has a huge z,
+// yet no reported figure resolves it (float carries ~1e-6, the paper's
+// resolution tolerance is 1.5e-2).
 struct Drift {
   double change = 0;  // b (n - 1): the trend's change over the window
   double z = 0;       // b / se(b)
   bool stationary = true;
 };
-Drift window_drift(const std::vector<double>& series, double z_limit = 3.0);
+Drift window_drift(const std::vector<double>& series, double z_limit = 3.0,
+                   double relative_floor = 1e-4);
 
 // Dynamically stationary: the means of the last two windows of `window`
 // samples differ by less than `tolerance` standard errors of their difference

@@ -281,6 +281,11 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   }
   // the paper's viscosities at a = 6 are calibrated for the paper's method
   EXPECT_EQ(pairs.viscosity_gap(6, 0.03, immersed_boundary::kPaperScheme), 1.0);
+  // and for the one-sweep option, so the standard preset (a = 6) takes it
+  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, immersed_boundary::kOneSweepScheme), 1.0);
+  const SuspensionCase standard = parse_suspension_case(
+      {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 12}});
+  EXPECT_EQ(standard.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
   // a = 8: no close-pair entry; refused with the field, the command and the way out
   EXPECT_THAT(
       refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}),

@@ -198,6 +198,16 @@ TEST(WindowDrift, AcceptsStationaryAr1AndRejectsASlowDrift) {
   for (std::size_t k = 0; k < rising.size(); ++k)
     rising[k] = 10 * (1 - std::exp(-static_cast<double>(k) / 4000.0)) + 0.3 * ar1(4000, 0.5, 3)[k];
   EXPECT_FALSE(window_drift(rising).stationary);
+  // a deterministic flow converging by 5e-8 of its mean (a fixed array's drag,
+  // float: no noise, so z is huge) is steady; the same shape at 1e-3 is not
+  std::vector<double> settled(20), converging(20);
+  for (std::size_t k = 0; k < settled.size(); ++k) {
+    settled[k] = 4.56 * (1 - 5e-8 * static_cast<double>(k) / 19);
+    converging[k] = 4.56 * (1 - 1e-3 * static_cast<double>(k) / 19);
+  }
+  EXPECT_TRUE(window_drift(settled).stationary);
+  EXPECT_GT(std::abs(window_drift(settled).z), 3.0);
+  EXPECT_FALSE(window_drift(converging).stationary);
 }
 
 }  // namespace
