@@ -245,10 +245,13 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
         for (const auto& a : t.columns) all += (all.empty() ? "" : ", ") + a;
         throw InputError("--columns " + c + ": no such column (columns: " + all + ")");
       }
-      chosen.push_back(c);
+      // each value brings its error column; one named as well is not repeated
+      auto add = [&chosen](const std::string& name) {
+        if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) chosen.push_back(name);
+      };
+      add(c);
       const std::string err = c + "_err";
-      if (std::find(t.columns.begin(), t.columns.end(), err) != t.columns.end())
-        chosen.push_back(err);
+      if (std::find(t.columns.begin(), t.columns.end(), err) != t.columns.end()) add(err);
     }
     cols = chosen;
   }

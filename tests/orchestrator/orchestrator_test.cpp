@@ -137,6 +137,11 @@ TEST_F(Orchestrator, LaunchRunsTheGridAndQueryShowsEveryResult) {
   q = t::run(flocsim({"query", "--db", db_, "--columns", "twice_x,x", "--format", "csv"}));
   ASSERT_EQ(q.code, 0) << q.out;
   EXPECT_EQ(q.out.rfind("twice_x,twice_x_err,x\n", 0), 0u) << q.out;
+  // an error column named as well comes once
+  q = t::run(
+      flocsim({"query", "--db", db_, "--columns", "twice_x,twice_x_err,x", "--format", "csv"}));
+  ASSERT_EQ(q.code, 0) << q.out;
+  EXPECT_EQ(q.out.rfind("twice_x,twice_x_err,x\n", 0), 0u) << q.out;
   q = t::run(flocsim({"query", "--db", db_, "--columns", "x,nosuch"}));
   EXPECT_EQ(q.code, 2);
   EXPECT_NE(q.out.find("--columns nosuch: no such column"), std::string::npos) << q.out;
