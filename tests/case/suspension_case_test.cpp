@@ -231,7 +231,7 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
     EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   }
   // where the option is not calibrated near the case's a and viscosity (a = 12
-  // has no one-sweep entry; a = 8 has one only at nu = 1/6, 6x away from 0.027)
+  // has no one-sweep entry)
   const SuspensionCase fine = parse_suspension_case({{"scene", "suspension"},
                                                      {"phi", 0.2},
                                                      {"lubrication_model", "nguyen-ladd"},
