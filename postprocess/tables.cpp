@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/observables/reference_correlations.hpp"
 #include "engine/result_names/result_names.hpp"
@@ -93,11 +94,17 @@ std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::st
             u.window_end = obs["window"].value("end", 0.0);
           }
           if (res.contains("case") && res["case"].is_object()) {
-            const json& rc = res["case"];
+            // as the current version writes it (older results lack fields that
+            // had one value then), so that only a real difference counts
+            const json rc = cases::with_older_versions_models(res["case"]);
+            const json lubrication = rc.value("lubrication_model", json());
+            const json numerics = rc.value("numerics", json::object());
             u.resolved_models =
-                "lubrication_model " + rc.value("lubrication_model", std::string("nguyen-ladd")) +
+                "lubrication_model " +
+                (lubrication.is_string() ? lubrication.get<std::string>() : std::string("none")) +
                 ", immersed boundary " +
-                rc.value("numerics", json::object()).value("immersed_boundary", json()).dump();
+                (numerics.is_object() ? numerics.value("immersed_boundary", json()) : json())
+                    .dump();
           }
           u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
           if (u.phi == 0) u.phi = res.value("derived", json::object()).value("phi_realised", 0.0);
@@ -139,13 +146,25 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
     if (r.du <= 0) continue;
     AggregationRow row;
     row.run = &r;
-    const auto it = zero_du.find(baseline_key(r.case_json));
-    const RunSummary* base = it == zero_du.end() ? nullptr : it->second.front();
     // The same input case may have resolved to other models under another
     // version (a changed default): such a pair is not a ratio of one model.
-    const bool other_models = base && !r.resolved_models.empty() &&
-                              !base->resolved_models.empty() &&
-                              r.resolved_models != base->resolved_models;
+    auto same_models = [&r](const RunSummary* b) {
+      return r.resolved_models.empty() || b->resolved_models.empty() ||
+             r.resolved_models == b->resolved_models;
+    };
+    auto usable = [](const RunSummary* b) {
+      return b->status == db::RunState::kCompleted && b->F && b->n_a;
+    };
+    // the first du = 0 run of the case that can serve (completed, same
+    // models); else the first one, to say why it cannot
+    const auto it = zero_du.find(baseline_key(r.case_json));
+    const RunSummary* base = nullptr;
+    if (it != zero_du.end()) {
+      for (const RunSummary* b : it->second)
+        if (!base && usable(b) && same_models(b)) base = b;
+      if (!base) base = it->second.front();
+    }
+    const bool other_models = base && !same_models(base);
     if (r.status != db::RunState::kCompleted || !r.F || !r.n_a) {
       row.reason = "this run is " + to_string(r.status) + (r.has_result ? " (no F or <n_a>)" : "");
     } else if (!base) {

@@ -239,11 +239,8 @@ std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
       if (std::find(seen.begin(), seen.end(), one.str()) == seen.end()) seen.push_back(one.str());
     }
     for (std::size_t k = 0; k < seen.size(); ++k) msg << (k ? "," : "") << seen[k];
-    msg << ". Run `flocsim calibrate --close-pairs --radius " << a << " --viscosity " << nu
-        << " --marker-spacing " << scheme.marker_spacing << " --sweeps " << scheme.sweeps
-        << " --kernel " << immersed_boundary::kernel_name(scheme.kernel)
-        << " --table engine/calibration/pair_resistance.json` and rebuild, or set "
-           "lubrication_model to nguyen-ladd.";
+    msg << ". Run `" << close_pair_calibrate_command(a, nu, scheme)
+        << "` and rebuild, or set lubrication_model to nguyen-ladd.";
     throw std::out_of_range(msg.str());
   }
   if (!below) below = above;
@@ -272,6 +269,17 @@ double PairResistanceTable::viscosity_gap(double a, double nu,
   if (!any) return std::numeric_limits<double>::infinity();
   if (below > 0 && std::isfinite(above)) return 1.0;
   return below > 0 ? nu / below : above / nu;
+}
+
+std::string close_pair_calibrate_command(double a, double nu,
+                                         const immersed_boundary::Scheme& scheme) {
+  std::ostringstream cmd;
+  cmd << "flocsim calibrate --close-pairs --radius " << a << " --viscosity " << nu;
+  if (a >= 6) cmd << " --pair-box 12";
+  cmd << " --marker-spacing " << scheme.marker_spacing << " --sweeps " << scheme.sweeps
+      << " --kernel " << immersed_boundary::kernel_name(scheme.kernel)
+      << " --table engine/calibration/pair_resistance.json";
+  return cmd.str();
 }
 
 }  // namespace flocsim::calibration

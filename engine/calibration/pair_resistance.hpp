@@ -67,6 +67,13 @@ PairResistanceEntry calibrate_pair_resistance(
     double hydrodynamic_radius, const std::vector<double>& gaps, bool separating,
     const PairResistanceSettings& s, void (*progress)(const PairResistancePoint&) = nullptr);
 
+// The `flocsim calibrate --close-pairs` command that makes the entry a case at
+// radius a, viscosity nu and IB scheme lacks (a >= 6 in a 12a box, as the
+// shipped a = 6 entries: a 16a box costs 2.4x more for the same lambda_IB
+// once the box's offset is removed).
+std::string close_pair_calibrate_command(double a, double nu,
+                                         const immersed_boundary::Scheme& scheme);
+
 class PairResistanceTable {
  public:
   static PairResistanceTable load(const std::string& filename);

@@ -202,20 +202,28 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // is only known later: the paper's method then) and calibrated for this a
     // within a factor 2 of this viscosity, else the paper's method. So does a
     // scene with the calibrated close-pair model where the option's close-pair
-    // resistance has not been measured at this a within a factor 2 of nu.
+    // resistance has not been measured at this a within a factor 2 of nu but
+    // the paper method's is nearer (where neither is, the faster one runs,
+    // with the same warning). "Factor 2" allows rounding: nu = 0.005 against
+    // an entry at 0.01 is within it.
+    constexpr double kFactor2 = 2.0 * (1 + 1e-9);
     const auto& radii = calibration::CalibrationTable::shipped();
     auto calibrated_near = [&](const immersed_boundary::Scheme& scheme) {
       return radii.has(a, scheme) &&
              std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
-                               c.numerics.viscosity)) <= std::log(2.0);
+                               c.numerics.viscosity)) <= std::log(kFactor2);
+    };
+    auto pair_gap = [&](const immersed_boundary::Scheme& scheme) {
+      return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
+                                                                       scheme);
     };
     immersed_boundary::Scheme preset_scheme = p.ib_scheme;
     if (!c.positions_from.empty() ||
         c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
         !calibrated_near(preset_scheme) ||
         (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
-         calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
-                                                                   preset_scheme) > 2.0))
+         pair_gap(preset_scheme) > kFactor2 &&
+         pair_gap(immersed_boundary::kPaperScheme) < pair_gap(preset_scheme)))
       preset_scheme = immersed_boundary::kPaperScheme;
     c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
   }
@@ -326,14 +334,13 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                        format_value(a) + ": " + e.what());
     }
     const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.ib_scheme);
-    if (gap > 2.0)
-      c.warnings.push_back("the close-pair calibration nearest to viscosity = " +
-                           format_value(c.numerics.viscosity) +
-                           " at a_over_dx = " + format_value(a) + " lies a factor " +
-                           format_value(gap) + " away; `flocsim calibrate --close-pairs --radius " +
-                           format_value(a) + " --viscosity " + format_value(c.numerics.viscosity) +
-                           " --table engine/calibration/pair_resistance.json` (with the "
-                           "scheme's --marker-spacing, --sweeps, --kernel) makes one");
+    if (gap > 2.0 * (1 + 1e-9))  // rounding: an entry exactly a factor 2 away is near
+      c.warnings.push_back(
+          "the close-pair calibration nearest to viscosity = " +
+          format_value(c.numerics.viscosity) + " at a_over_dx = " + format_value(a) +
+          " lies a factor " + format_value(gap) + " away; `" +
+          calibration::close_pair_calibrate_command(a, c.numerics.viscosity, c.numerics.ib_scheme) +
+          "` and a rebuild make one");
     if (c.numerics.input_radius_given)
       c.warnings.push_back(
           "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +
@@ -500,6 +507,29 @@ nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme) {
   return {{"marker_spacing", scheme.marker_spacing},
           {"sweeps", scheme.sweeps},
           {"kernel", immersed_boundary::kernel_name(scheme.kernel)}};
+}
+
+nlohmann::json with_older_versions_models(nlohmann::json c) {
+  if (!c.is_object()) return c;
+  const std::string scene =
+      c.contains("scene") && c["scene"].is_string() ? c["scene"].get<std::string>() : "";
+  bool immersed = false, lubricated = false;
+  for (const auto& entry : kScenes)
+    if (scene == entry.name) {
+      immersed = entry.modules.liquid && entry.modules.spheres;
+      lubricated = entry.modules.lubrication;
+    }
+  if (immersed && c.contains("numerics") && c["numerics"].is_object() &&
+      !c["numerics"].contains("immersed_boundary"))
+    c["numerics"]["immersed_boundary"] = immersed_boundary_json(immersed_boundary::kPaperScheme);
+  if (!lubricated) {
+    c.erase("lubrication_model");
+    c.erase("lubrication_integration");
+  } else {
+    if (!c.contains("lubrication_model")) c["lubrication_model"] = "nguyen-ladd";
+    if (!c.contains("lubrication_integration")) c["lubrication_integration"] = "implicit";
+  }
+  return c;
 }
 
 }  // namespace flocsim::cases

@@ -142,6 +142,15 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document);
 // numerics.immersed_boundary as a case file writes it: {marker_spacing, sweeps, kernel}.
 nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme);
 
+// A resolved case (result.json's or a checkpoint's "case") as the current
+// version writes it: fields that older versions did not write had one value
+// each then. numerics.immersed_boundary was the paper's method; a lubricated
+// scene's lubrication_model was Nguyen-Ladd's, integrated implicitly. Scenes
+// without lubrication carry those fields (with whatever default their version
+// had) but do not use them, so they are removed. Used wherever two runs' models are compared
+// (resume, F/F0 baselines).
+nlohmann::json with_older_versions_models(nlohmann::json resolved_case);
+
 // Schiller-Naumann: C_D = 24/Re (1 + 0.15 Re^0.687).
 double schiller_naumann_drag_coefficient(double reynolds);
 

@@ -40,6 +40,26 @@ void LubricationParams::check() const {
 
 RadialLubrication::RadialLubrication(LubricationParams params) : params_(params) {
   params_.check();
+  if (params_.lattice_share.empty()) return;
+  log_first_ = std::log(params_.saturation_gap);
+  log_step_ = (std::log(params_.onset_gap) - log_first_) / (kExactPoints - 1);
+  gap_times_exact_.resize(kExactPoints);
+  for (int k = 0; k < kExactPoints; ++k) {
+    const double e = std::exp(log_first_ + k * log_step_);
+    gap_times_exact_[k] = e * brenner_pair_resistance(e);
+  }
+}
+
+double RadialLubrication::exact_resistance(double e) const {
+  // the cubic through points k-1 .. k+2 (shifted inwards at the ends), in the
+  // grid coordinate t = x - k
+  const double x = (std::log(e) - log_first_) / log_step_;
+  const int k = std::clamp(static_cast<int>(std::floor(x)), 1, kExactPoints - 3);
+  const double t = x - k;
+  const double* g = &gap_times_exact_[k - 1];
+  const double w0 = -t * (t - 1) * (t - 2) / 6, w1 = (t + 1) * (t - 1) * (t - 2) / 2,
+               w2 = -(t + 1) * t * (t - 2) / 2, w3 = (t + 1) * t * (t - 1) / 6;
+  return (w0 * g[0] + w1 * g[1] + w2 * g[2] + w3 * g[3]) / e;
 }
 
 double RadialLubrication::coefficient(double gap, double radius) const {
@@ -65,7 +85,7 @@ double RadialLubrication::coefficient(double gap, double radius) const {
     // does at small viscosity from about 0.07a up: docs/contacts.md): the
     // correction then takes the excess off, and the pair's total is still the
     // exact, positive resistance.
-    const double excess = brenner_pair_resistance(e) - share;
+    const double excess = exact_resistance(e) - share;
     return 3.0 * M_PI * params_.liquid_density * params_.viscosity * radius * excess;
   }
   return 1.5 * M_PI * params_.liquid_density * params_.viscosity * radius * radius *

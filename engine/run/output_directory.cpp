@@ -183,27 +183,9 @@ nlohmann::json physics_only(nlohmann::json c) {
   }
   if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
     c["run"].erase("steps");
-  // Checkpoints from before numerics.immersed_boundary existed were run with
-  // the paper's method, the only one there was.
-  if (c.contains("numerics") && c["numerics"].is_object() && c["numerics"].contains("a_over_dx") &&
-      c.value("scene", "") != cases::scene_name(cases::Scene::granular) &&
-      c.value("scene", "") != cases::scene_name(cases::Scene::fluid) &&
-      !c["numerics"].contains("immersed_boundary")) {
-    c["numerics"]["immersed_boundary"] =
-        cases::immersed_boundary_json(immersed_boundary::kPaperScheme);
-  }
-  // Checkpoints from before lubrication_model existed used Nguyen-Ladd's
-  // correction, the only one there was. Scenes without lubrication carry the
-  // field (with whatever default their version had) but do not use it, so it
-  // does not decide whether they resume.
-  bool lubricated = false;
-  for (const auto& entry : cases::kScenes)
-    if (c.value("scene", "") == entry.name) lubricated = entry.modules.lubrication;
-  if (!lubricated)
-    c.erase("lubrication_model");
-  else if (!c.contains("lubrication_model"))
-    c["lubrication_model"] = "nguyen-ladd";
-  return c;
+  // checkpoints from before numerics.immersed_boundary or lubrication_model
+  // existed: the one value each had then
+  return cases::with_older_versions_models(std::move(c));
 }
 
 void list_differences(const nlohmann::json& was, const nlohmann::json& now,

@@ -95,7 +95,7 @@ TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
 }
 
 TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
-  // (a = 8 has no close-pair calibration: Nguyen-Ladd's correction, by name)
+  // (Nguyen-Ladd's correction by name: the test is about the radius, not close pairs)
   const SuspensionCase c = parse_suspension_case({{"scene", "suspension"},
                                                   {"fidelity", "draft"},
                                                   {"phi", 0.2},
@@ -230,6 +230,13 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
                                                         {"phi", 0.25}});
     EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
   }
+  // a = 8 (Nguyen-Ladd's correction: no close-pair entry needed): the option's
+  // radius is calibrated at nu 0.01-0.04, so the preset takes it
+  const SuspensionCase a8 = parse_suspension_case({{"scene", "suspension"},
+                                                   {"phi", 0.2},
+                                                   {"lubrication_model", "nguyen-ladd"},
+                                                   {"numerics", {{"a_over_dx", 8}}}});
+  EXPECT_EQ(a8.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
   // where the option is not calibrated near the case's a and viscosity (a = 12
   // has no one-sweep entry)
   const SuspensionCase fine = parse_suspension_case({{"scene", "suspension"},
@@ -286,10 +293,31 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   const SuspensionCase standard = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 12}});
   EXPECT_EQ(standard.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  // a = 8: no close-pair entry; refused with the field, the command and the way out
+  const SuspensionCase draft = parse_suspension_case(
+      {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}, {"Re_inf", 12}});
+  EXPECT_EQ(draft.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  // Re_inf 72 at a = 6 (nu = 0.005): the close pairs of both schemes are
+  // calibrated only from nu = 0.02, 4x away, so the faster one runs, warned
+  const SuspensionCase fast = parse_suspension_case(
+      {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 72}});
+  EXPECT_DOUBLE_EQ(fast.numerics.viscosity, 0.005);
+  EXPECT_EQ(fast.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  bool gap_named = false;
+  for (const auto& w : fast.warnings)
+    gap_named =
+        gap_named || (w.find("factor 4") != std::string::npos &&
+                      w.find("--pair-box 12 --marker-spacing 1 --sweeps 1") != std::string::npos);
+  EXPECT_TRUE(gap_named);
+  // a = 8: close pairs calibrated for the paper's method only (nu = 0.02), so
+  // the preset falls back to it from the one-sweep option
+  const SuspensionCase a8 = parse_suspension_case(
+      {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}});
+  EXPECT_EQ(a8.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_LE(pairs.viscosity_gap(8, a8.numerics.viscosity, immersed_boundary::kPaperScheme), 2.0);
+  // a = 12: no close-pair entry; refused with the field, the command and the way out
   EXPECT_THAT(
-      refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}),
-      AllOf(HasSubstr("lubrication_model = \"calibrated\""), HasSubstr("numerics.a_over_dx = 8"),
+      refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 12}}}}),
+      AllOf(HasSubstr("lubrication_model = \"calibrated\""), HasSubstr("numerics.a_over_dx = 12"),
             HasSubstr("flocsim calibrate --close-pairs"), HasSubstr("nguyen-ladd")));
   // scenes without lubrication need no close-pair entry
   EXPECT_NO_THROW(parse_suspension_case(

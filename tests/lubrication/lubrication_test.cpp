@@ -217,12 +217,40 @@ TEST(RadialLubrication, CalibratedCoefficientIsExactMinusLatticeShare) {
   const double a = 4.0, unit = 3 * M_PI * (1.0 / 6.0) * a;
   EXPECT_NEAR(lub.coefficient(0.05 * a, a) / unit, 12.71 - 6.51, 0.01);
   // between points the share is linear: at 0.03a, 7.02 - (1/3)(0.51) = 6.85
-  EXPECT_NEAR(lub.coefficient(0.03 * a, a) / unit + 6.85, brenner_pair_resistance(0.03), 1e-12);
+  // (the exact part is tabulated: good to 1e-9 of it, test below)
+  EXPECT_NEAR(lub.coefficient(0.03 * a, a) / unit + 6.85, brenner_pair_resistance(0.03),
+              1e-9 * brenner_pair_resistance(0.03));
   // below s1 saturated, above s0 zero
   EXPECT_EQ(lub.coefficient(1e-5 * a, a), lub.coefficient(2e-4 * a, a));
   EXPECT_EQ(lub.coefficient(0.21 * a, a), 0.0);
   // closer is stiffer
   EXPECT_GT(lub.coefficient(0.01 * a, a), lub.coefficient(0.02 * a, a));
+}
+
+// The exact resistance is tabulated once per model (the series costs up to
+// ~1400 terms a pair near s1): across the whole range s1 <= s <= s0, at gaps
+// between the grid points and on them, it matches the series to 1e-9.
+TEST(RadialLubrication, TabulatedExactResistanceMatchesTheSeries) {
+  const RadialLubrication lub(calibrated_a4());
+  const double a = 4.0, unit = 3 * M_PI * (1.0 / 6.0) * a;
+  double worst = 0;
+  for (int k = 0; k <= 3000; ++k) {
+    const double e = 2e-4 * std::pow(0.2 / 2e-4, k / 3000.0);
+    const auto& t = calibrated_a4().lattice_share;
+    double share = t.front().second;  // as the model interpolates it
+    if (e >= t.back().first) {
+      share = t.back().second;
+    } else if (e > t.front().first) {
+      std::size_t j = 1;
+      while (t[j].first < e) ++j;
+      share = t[j - 1].second + (e - t[j - 1].first) / (t[j].first - t[j - 1].first) *
+                                    (t[j].second - t[j - 1].second);
+    }
+    const double exact = brenner_pair_resistance(e);
+    worst = std::max(worst, std::abs(lub.coefficient(e * a, a) / unit + share - exact) / exact);
+  }
+  EXPECT_LT(worst, 1e-9);
+  std::printf("largest relative error of the tabulated exact resistance: %.2e\n", worst);
 }
 
 // Brenner's definition, worked by hand: two spheres each moving at U towards
@@ -280,7 +308,7 @@ TEST(RadialLubrication, CalibratedTakesOffWhatTheLatticeOvercounts) {
   const RadialLubrication lub({.viscosity = 0.02, .lattice_share = {{0.1, 8.13}, {0.15, 6.41}}});
   const double a = 4.0;
   EXPECT_NEAR(lub.coefficient(0.15 * a, a) / (3 * M_PI * 0.02 * a),
-              brenner_pair_resistance(0.15) - 6.41, 1e-12);
+              brenner_pair_resistance(0.15) - 6.41, 1e-9 * brenner_pair_resistance(0.15));
   EXPECT_LT(lub.coefficient(0.15 * a, a), 0.0);
   const Vec3 n = Vec3(0.3, -1, 0.2).normalized();
   for (double dt : {1.0, 1e4, 1e8}) {

@@ -208,6 +208,18 @@ TEST(WindowDrift, AcceptsStationaryAr1AndRejectsASlowDrift) {
   EXPECT_TRUE(window_drift(settled).stationary);
   EXPECT_GT(std::abs(window_drift(settled).z), 3.0);
   EXPECT_FALSE(window_drift(converging).stationary);
+  // the floor is relative to |mean|: the same with the sign flipped; a series
+  // about zero has no floor, so its drift is judged by z alone; NaN is no steady state
+  for (auto& x : settled) x = -x;
+  for (auto& x : converging) x = -x;
+  EXPECT_TRUE(window_drift(settled).stationary);
+  EXPECT_FALSE(window_drift(converging).stationary);
+  std::vector<double> about_zero(20);
+  for (std::size_t k = 0; k < about_zero.size(); ++k)
+    about_zero[k] = 1e-9 * (static_cast<double>(k) - 9.5);
+  EXPECT_FALSE(window_drift(about_zero).stationary);
+  settled[7] = std::nan("");
+  EXPECT_FALSE(window_drift(settled).stationary);
 }
 
 }  // namespace

@@ -36,6 +36,7 @@ struct HandRun {
   std::string state;  // completed | failed | running | pending
   double F = 0, F_err = 0, n_a = 0, n_a_err = 0;
   std::string lubrication_model;  // as the run resolved it (result.json's case); "" for none
+  json immersed_boundary;         // as the run resolved it; null: not written (older versions)
 };
 
 json suspension(double du, double re_inf = 12, double a = 4) {
@@ -98,6 +99,8 @@ class Post : public ::testing::Test {
       if (!r.lubrication_model.empty()) {
         result["case"] = r.case_json;
         result["case"]["lubrication_model"] = r.lubrication_model;
+        if (!r.immersed_boundary.is_null())
+          result["case"]["numerics"]["immersed_boundary"] = r.immersed_boundary;
       }
       rec.result_json = result.dump();
       rec.observables = {{"F", r.F, r.F_err}, {"n_a_mean", r.n_a, r.n_a_err}, {"Re", 4.0, 0.1},
@@ -201,6 +204,45 @@ TEST_F(Post, NoBaselineAcrossResolvedModels) {
       EXPECT_NEAR(r.F_over_F0->mean, 2.8 / 4.0, 1e-12);
     }
   }
+}
+
+// Results of older versions lack numerics.immersed_boundary: they ran the
+// paper's method (0.7 dx, 2 sweeps, roma3), so they pair with a run that names
+// it and not with one that ran another scheme. Of several du = 0 runs of one
+// case the first that ran the same models serves.
+TEST_F(Post, OlderResultsPairByTheModelsTheyRan) {
+  const json paper = {{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}};
+  const json one_sweep = {{"marker_spacing", 1.0}, {"sweeps", 1}, {"kernel", "roma3"}};
+  const std::string db_path = write_db({
+      {"old0", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1, "calibrated"},  // no IB field
+      {"new1", suspension(0.01), "completed", 3.6, 0.1, 4.0, 0.2, "calibrated", paper},
+      {"new2", suspension(0.02), "completed", 3.2, 0.1, 8.0, 0.4, "calibrated", one_sweep},
+  });
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  auto rows = aggregation_table(load_runs(db, std::nullopt, {}));
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& r : rows) {
+    if (r.run->id == "new1") {
+      ASSERT_NE(r.baseline, nullptr) << r.reason;
+      EXPECT_NEAR(r.F_over_F0->mean, 3.6 / 4.0, 1e-12);
+    } else {
+      EXPECT_EQ(r.baseline, nullptr);
+      EXPECT_THAT(r.reason, AllOf(HasSubstr("\"sweeps\":2"), HasSubstr("\"sweeps\":1")));
+    }
+  }
+  // two baselines: the one with the other model comes first, the matching one serves
+  fs::rename(db_path, fs::path(db_path).parent_path() / "first.db");  // write_db's path is reused
+  const std::string db_path2 = write_db({
+      {"nl0", suspension(0), "completed", 4.2, 0.1, 2.0, 0.1, "nguyen-ladd", paper},
+      {"cal0", suspension(0), "completed", 4.0, 0.1, 2.0, 0.1, "calibrated", paper},
+      {"cal2", suspension(0.02), "completed", 3.0, 0.1, 8.0, 0.4, "calibrated", paper},
+  });
+  db::ResultsDb second(db_path2, db::ResultsDb::Mode::kReadOnly);
+  rows = aggregation_table(load_runs(second, std::nullopt, {}));
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_NE(rows[0].baseline, nullptr) << rows[0].reason;
+  EXPECT_EQ(rows[0].baseline->id, "cal0");
+  EXPECT_NEAR(rows[0].F_over_F0->mean, 3.0 / 4.0, 1e-12);
 }
 
 TEST_F(Post, NoBaselineAcrossNumericsAndEveryMissingBaselineHasItsReason) {

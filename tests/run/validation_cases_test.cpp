@@ -1,0 +1,48 @@
+// The case files committed beside the validation results (docs/validation/)
+// must still describe the runs that made those results: parsed by this
+// version, each resolves to the case its result.json recorded (the same test a
+// resume applies), so a changed default (an IB scheme a preset now picks, a
+// lubrication model) cannot silently detach a committed case from its data.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "engine/case/suspension_case.hpp"
+#include "engine/run/output_directory.hpp"
+
+namespace flocsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
+  const fs::path root = FLOCSIM_SOURCE_DIR;
+  // snapshot paths in the cases are relative to the repository root
+  const fs::path was = fs::current_path();
+  fs::current_path(root);
+  int checked = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(root / "docs" / "validation")) {
+    if (entry.path().filename() != "case.json") continue;
+    const fs::path result = entry.path().parent_path() / "result.json";
+    if (!fs::exists(result)) continue;
+    SCOPED_TRACE(fs::relative(entry.path(), root).string());
+    nlohmann::json ran = read_json(result).at("case");
+    nlohmann::json now = cases::parse_suspension_case(read_json(entry.path())).to_json();
+    // where the snapshot was read from is provenance, not physics
+    ran.erase("positions_from");
+    now.erase("positions_from");
+    EXPECT_TRUE(run::resumable_under(ran, now)) << "differs: " << run::case_differences(ran, now);
+    ++checked;
+  }
+  fs::current_path(was);
+  EXPECT_GE(checked, 10);
+}
+
+}  // namespace
+}  // namespace flocsim
