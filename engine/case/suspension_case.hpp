@@ -53,6 +53,9 @@ struct Physics {
   // measured share (shipped close-pair calibration, docs/contacts.md);
   // "nguyen-ladd": (3/2) pi rho nu a^2 (1/s - 1/s0), which assumes the lattice
   // resolves nothing more below s0 and so counts part of the resistance twice.
+  // A case file defaults to "calibrated" (parse_suspension_case fills the
+  // lattice's share); a struct built in code has no share, so its default is
+  // the model that needs none.
   std::string lubrication_model = "nguyen-ladd";
   // "implicit": backward Euler per pair, never reverses an approach;
   // "explicit-paper": forward Euler as in the paper, which can (for comparison).

@@ -93,11 +93,7 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
                      Baseline& base) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
   const auto recorded = nlohmann::json::parse(f.attribute_string("/", "case"));
-  if (!resumable_under(recorded, c.to_json()))
-    throw input::InputError(file.string() + " belongs to a different case (" +
-                            case_differences(recorded, c.to_json()) +
-                            "); give those fields their recorded values to continue it, or use "
-                            "another --out directory");
+  require_resumable(file, recorded, c.to_json());
   restore_populations(f, fluid, file);
   fluid.set_time_step(f.attribute_int("/", "time_step"));
   base.mass = f.attribute_double("/", "baseline_mass");

@@ -233,4 +233,13 @@ RunReport blown_up_run(RunLog& log, const std::string& where, const std::string&
   return r;
 }
 
+void require_resumable(const std::filesystem::path& checkpoint, const nlohmann::json& recorded_case,
+                       const nlohmann::json& current_case) {
+  if (resumable_under(recorded_case, current_case)) return;
+  throw input::InputError(checkpoint.string() + " belongs to a different case (" +
+                          case_differences(recorded_case, current_case) +
+                          "); give those fields their recorded values to continue it, or use "
+                          "another --out directory");
+}
+
 }  // namespace flocsim::run

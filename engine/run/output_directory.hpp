@@ -57,5 +57,9 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
 // checkpoint, new now" for each differing field, joined by "; ".
 std::string case_differences(const nlohmann::json& checkpoint_case,
                              const nlohmann::json& current_case);
+// Throws input::InputError naming the checkpoint file and the differing
+// fields unless the checkpoint's case is resumable under the current one.
+void require_resumable(const std::filesystem::path& checkpoint, const nlohmann::json& recorded_case,
+                       const nlohmann::json& current_case);
 
 }  // namespace flocsim::run

@@ -99,11 +99,7 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, Spher
                      Liquid<Real>* liquid) {
   output::Hdf5File f(file, output::Hdf5File::Mode::read);
   const auto recorded = nlohmann::json::parse(f.attribute_string("/", "case"));
-  if (!resumable_under(recorded, c.to_json()))
-    throw input::InputError(file.string() + " belongs to a different case (" +
-                            case_differences(recorded, c.to_json()) +
-                            "); give those fields their recorded values to continue it, or use "
-                            "another --out directory");
+  require_resumable(file, recorded, c.to_json());
   s.spheres.position = unflatten(f.read<double>("/spheres/position"));
   s.spheres.velocity = unflatten(f.read<double>("/spheres/velocity"));
   s.spheres.angular_velocity = unflatten(f.read<double>("/spheres/angular_velocity"));
