@@ -20,6 +20,10 @@ using input::Range;
 
 namespace {
 
+// A calibration entry counts as near the case's viscosity within this factor
+// (rounding allowed: nu = 0.005 against an entry at 0.01 is near).
+constexpr double kNearViscosityFactor = 2.0 * (1 + 1e-9);
+
 // Resolution, domain and durations of each fidelity preset. The paper preset
 // is the paper's default case (a = 6 dx, L = 48a, L/W = 2); standard keeps
 // the resolution and shrinks the domain (the paper saw <= 4 % domain-size
@@ -204,14 +208,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // scene with the calibrated close-pair model where the option's close-pair
     // resistance has not been measured at this a within a factor 2 of nu but
     // the paper method's is nearer (where neither is, the faster one runs,
-    // with the same warning). "Factor 2" allows rounding: nu = 0.005 against
-    // an entry at 0.01 is within it.
-    constexpr double kFactor2 = 2.0 * (1 + 1e-9);
+    // with the same warning).
     const auto& radii = calibration::CalibrationTable::shipped();
     auto calibrated_near = [&](const immersed_boundary::Scheme& scheme) {
       return radii.has(a, scheme) &&
              std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
-                               c.numerics.viscosity)) <= std::log(kFactor2);
+                               c.numerics.viscosity)) <= std::log(kNearViscosityFactor);
     };
     auto pair_gap = [&](const immersed_boundary::Scheme& scheme) {
       return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
@@ -222,7 +224,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
         c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
         !calibrated_near(preset_scheme) ||
         (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
-         pair_gap(preset_scheme) > kFactor2 &&
+         pair_gap(preset_scheme) > kNearViscosityFactor &&
          pair_gap(immersed_boundary::kPaperScheme) < pair_gap(preset_scheme)))
       preset_scheme = immersed_boundary::kPaperScheme;
     c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
@@ -334,7 +336,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                        format_value(a) + ": " + e.what());
     }
     const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.ib_scheme);
-    if (gap > 2.0 * (1 + 1e-9))  // rounding: an entry exactly a factor 2 away is near
+    if (gap > kNearViscosityFactor)
       c.warnings.push_back(
           "the close-pair calibration nearest to viscosity = " +
           format_value(c.numerics.viscosity) + " at a_over_dx = " + format_value(a) +
