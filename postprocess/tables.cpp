@@ -420,7 +420,7 @@ All quantities are dimensionless (paper section 2 and docs/model.md).
 | window | statistics window, t U_inf / a |
 | N | number of spheres |
 | errors_reliable | every batch of the batch-means errors spans at least 5 correlation times (for the pair: in both runs) |
-| stationary | "yes", or "no:" with the observables whose window still drifts (|z| > 3 on a fitted trend) |
+| stationary | "yes", or "no:" with the observables whose window still drifts (|z| > 3 on a fitted trend whose change over the window exceeds 1e-4 of the mean) |
 | F_Beetstra | Beetstra et al. (2007), paper eq. 4, at the run's phi and Re (static random arrays) |
 | F_Wylie | Wylie et al. (2003), paper eq. 5, at the run's phi, Re and Re_T |
 | U_over_Uinf_RZ | Richardson-Zaki (1 - phi)^n, n from Re_inf |
