@@ -203,6 +203,23 @@ namespace {
 bool same_scheme(const PairResistanceEntry& e, double a, const immersed_boundary::Scheme& scheme) {
   return !e.separating && std::abs(e.hydrodynamic_radius - a) <= 1e-6 && e.scheme == scheme;
 }
+
+// The approaching entries of this a and scheme nearest nu from below and from
+// above (either null where none lies on that side).
+struct Bracket {
+  const PairResistanceEntry* below = nullptr;
+  const PairResistanceEntry* above = nullptr;
+};
+Bracket bracket(const std::vector<PairResistanceEntry>& entries, double a, double nu,
+                const immersed_boundary::Scheme& scheme) {
+  Bracket b;
+  for (const auto& e : entries) {
+    if (!same_scheme(e, a, scheme)) continue;
+    if (e.viscosity <= nu && (!b.below || e.viscosity > b.below->viscosity)) b.below = &e;
+    if (e.viscosity >= nu && (!b.above || e.viscosity < b.above->viscosity)) b.above = &e;
+  }
+  return b;
+}
 }  // namespace
 
 void PairResistanceTable::add(const PairResistanceEntry& entry) {
@@ -221,12 +238,7 @@ bool PairResistanceTable::has(double a, const immersed_boundary::Scheme& scheme)
 
 std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
     double a, double nu, const immersed_boundary::Scheme& scheme) const {
-  const PairResistanceEntry *below = nullptr, *above = nullptr;
-  for (const auto& e : entries_) {
-    if (!same_scheme(e, a, scheme)) continue;
-    if (e.viscosity <= nu && (!below || e.viscosity > below->viscosity)) below = &e;
-    if (e.viscosity >= nu && (!above || e.viscosity < above->viscosity)) above = &e;
-  }
+  auto [below, above] = bracket(entries_, a, nu, scheme);
   if (!below && !above) {
     std::ostringstream msg;
     msg << "no close-pair calibration for a = " << a << " dx with " << scheme.describe()
@@ -258,17 +270,10 @@ std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
 
 double PairResistanceTable::viscosity_gap(double a, double nu,
                                           const immersed_boundary::Scheme& scheme) const {
-  double below = 0, above = std::numeric_limits<double>::infinity();
-  bool any = false;
-  for (const auto& e : entries_) {
-    if (!same_scheme(e, a, scheme)) continue;
-    any = true;
-    if (e.viscosity <= nu) below = std::max(below, e.viscosity);
-    if (e.viscosity >= nu) above = std::min(above, e.viscosity);
-  }
-  if (!any) return std::numeric_limits<double>::infinity();
-  if (below > 0 && std::isfinite(above)) return 1.0;
-  return below > 0 ? nu / below : above / nu;
+  const auto [below, above] = bracket(entries_, a, nu, scheme);
+  if (!below && !above) return std::numeric_limits<double>::infinity();
+  if (below && above) return 1.0;
+  return below ? nu / below->viscosity : above->viscosity / nu;
 }
 
 std::string close_pair_calibrate_command(double a, double nu,
