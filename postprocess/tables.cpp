@@ -175,7 +175,7 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
       row.reason = "its du = 0 run " + base->id.substr(0, 12) + " ran with " +
                    base->resolved_models + ", this one with " + r.resolved_models +
                    " (defaults of different flocsim versions); name them in the sweep's base";
-    } else if (base->status != db::RunState::kCompleted || !base->F || !base->n_a) {
+    } else if (!usable(base)) {
       row.reason = "its baseline " + base->id.substr(0, 12) + " is " + to_string(base->status);
     } else {
       row.baseline = base;
