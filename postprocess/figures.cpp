@@ -11,6 +11,7 @@
 
 #include "engine/observables/reference_correlations.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "postprocess/paper_values.hpp"
 
 namespace flocsim::postprocess {
 
@@ -330,6 +331,14 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
         if (rows.str().empty()) continue;
         plots += (plots.empty() ? "" : ", ") + p.data(label(phi, re), rows.str()) + " " + kPoint +
                  " title 'phi = " + num(phi) + ", Re_{inf} = " + num(re) + "'";
+        // the paper's stated values for the same (phi, Re_inf), open symbols
+        std::ostringstream paper;
+        for (const PaperAggregateSize& q : paper_aggregate_sizes(phi, re))
+          paper << num(q.du_over_Uinf) << " " << num(q.n_a) << "\n";
+        if (!paper.str().empty())
+          plots += ", " + p.data("paper_" + label(phi, re), paper.str()) +
+                   " with points pt 6 ps 1.5 title 'paper (Fig. 9), phi = " + num(phi) +
+                   ", Re_{inf} = " + num(re) + "'";
       }
     if (dus.size() < 2 || plots.empty()) {
       set.skipped.push_back("n_a_vs_du: fewer than two values of du/U_inf");

@@ -10,6 +10,7 @@
 #include "engine/observables/reference_correlations.hpp"
 #include "engine/result_names/result_names.hpp"
 #include "orchestrator/sweep.hpp"
+#include "postprocess/paper_values.hpp"
 
 namespace flocsim::postprocess {
 
@@ -146,6 +147,9 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
     if (r.du <= 0) continue;
     AggregationRow row;
     row.run = &r;
+    row.n_a_paper = paper_mean_aggregate_size(r.phi, r.re_inf, r.du);
+    // the paper gives no error: the ratio carries flocsim's alone
+    if (row.n_a_paper && r.n_a) row.n_over_paper = ratio(*r.n_a, {*row.n_a_paper, 0.0});
     // The same input case may have resolved to other models under another
     // version (a changed default): such a pair is not a ratio of one model.
     auto same_models = [&r](const RunSummary* b) {
@@ -320,6 +324,8 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
             "n_a",
             "n_a0",
             "n_a_over_n_a0",
+            "n_a_paper",
+            "n_a_over_paper",
             "U_over_Uinf",
             "C_sph",
             "Re_T",
@@ -330,8 +336,8 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
             "run",
             "baseline",
             "note"},
-           {false, false, false, true,  true,  true,  true,  true,  true,  true,
-            true,  true,  true,  false, false, false, false, false, false, false});
+           {false, false, false, true, true,  true,  true,  true,  true,  true,  false,
+            true,  true,  true,  true, false, false, false, false, false, false, false});
   for (const AggregationRow& row : rows) {
     const RunSummary& r = *row.run;
     const RunSummary* b = row.baseline;
@@ -345,6 +351,11 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
     w.measured(r.n_a);
     w.measured(b ? b->n_a : std::nullopt);
     w.measured(row.n_over_n0);
+    if (row.n_a_paper)
+      w.value(*row.n_a_paper);
+    else
+      w.text("");
+    w.measured(row.n_over_paper);
     w.measured(r.U_over_Uinf);
     w.measured(r.C_sph);
     w.measured(r.Re_T);
@@ -414,6 +425,8 @@ All quantities are dimensionless (paper section 2 and docs/model.md).
 | n_a | mass-weighted mean aggregate size <n_a> (spheres within 2(a + delta) are bonded) |
 | n_a0 | <n_a> of the baseline (du = 0: clusters of spheres that merely touch) |
 | n_a_over_n_a0 | <n_a> / <n_a>0 |
+| n_a_paper | the paper's <n_a> where its text states one (Fig. 9: phi 0.2, Re_inf 12, du/U_inf 0.01, 0.02, 0.03; a = 6, N = 1320; no error given) |
+| n_a_over_paper | n_a / n_a_paper, with flocsim's error only |
 | U_over_Uinf | U / U_inf |
 | C_sph | contacts per sphere: other centres within 2(a + delta) |
 | Re_T | T^(1/2) 2a / nu, T the granular temperature |

@@ -63,6 +63,8 @@ struct AggregationRow {
   const RunSummary* baseline = nullptr;  // null: see reason
   std::string reason;                    // why there is no pairing (empty when paired)
   std::optional<Measured> F_over_F0, n_over_n0;
+  std::optional<double> n_a_paper;       // the paper's stated <n_a> for this case, if any
+  std::optional<Measured> n_over_paper;  // <n_a> / n_a_paper (flocsim's error only)
 };
 // One row per run with du/U_inf > 0, paired where a completed baseline exists.
 std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs);

@@ -19,6 +19,7 @@
 #include "orchestrator/report.hpp"
 #include "orchestrator/sweep.hpp"
 #include "postprocess/figures.hpp"
+#include "postprocess/paper_values.hpp"
 #include "postprocess/report.hpp"
 #include "postprocess/tables.hpp"
 
@@ -159,6 +160,12 @@ TEST_F(Post, AggregationTableEqualsAHandCalculation) {
   EXPECT_NEAR(*rows[0].F_over_F0->error, 0.0318198052, 1e-9);
   EXPECT_NEAR(rows[0].n_over_n0->mean, 4.0, 1e-14);
   EXPECT_NEAR(*rows[0].n_over_n0->error, 0.2828427125, 1e-9);
+  // phi 0.2, Re_inf 12, du 0.02 is the paper's Fig. 9 case (<n_a> = 11.9, no
+  // error given): 8.0 / 11.9 = 0.6722689 with flocsim's 0.4 / 11.9 = 0.0336134.
+  ASSERT_TRUE(rows[0].n_a_paper.has_value());
+  EXPECT_EQ(*rows[0].n_a_paper, 11.9);
+  EXPECT_NEAR(rows[0].n_over_paper->mean, 0.6722689076, 1e-9);
+  EXPECT_NEAR(*rows[0].n_over_paper->error, 0.0336134454, 1e-9);
   std::ostringstream md, csv, tex;
   write_aggregation(rows, "md", md);
   write_aggregation(rows, "csv", csv);
@@ -168,6 +175,18 @@ TEST_F(Post, AggregationTableEqualsAHandCalculation) {
   EXPECT_THAT(csv.str(), HasSubstr(",0.75,0.03181980515,"));  // full precision in CSV
   EXPECT_THAT(tex.str(), HasSubstr("$0.75 \\pm 0.03$"));
   EXPECT_THAT(tex.str(), HasSubstr("\\toprule"));
+}
+
+// The paper states <n_a> only for phi 0.2, Re_inf 12 at du/U_inf 0.01, 0.02,
+// 0.03 (Fig. 9 caption); any other case gets an empty column, never a value
+// read off a neighbour.
+TEST(PaperValues, OnlyTheStatedCasesHaveAPublishedAggregateSize) {
+  EXPECT_EQ(paper_mean_aggregate_size(0.2, 12, 0.01), 4.88);
+  EXPECT_EQ(paper_mean_aggregate_size(0.2, 12, 0.03), 59.4);
+  EXPECT_FALSE(paper_mean_aggregate_size(0.2, 12, 0.025).has_value());
+  EXPECT_FALSE(paper_mean_aggregate_size(0.2, 24, 0.02).has_value());
+  EXPECT_FALSE(paper_mean_aggregate_size(0.12, 12, 0.02).has_value());
+  EXPECT_FALSE(paper_mean_aggregate_size(0.2, 12, 0).has_value());
 }
 
 TEST_F(Post, ABaselineThatLeavesDuAtItsDefaultIsFound) {
