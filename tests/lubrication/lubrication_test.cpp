@@ -160,6 +160,47 @@ TEST(RadialLubrication, SaturatedApproachSlowsWithoutOverlap) {
   EXPECT_GE(resolved.min_gap, -1e-12 * kA);
 }
 
+// What a bond of the square well holds (the mechanism behind "excess close-pair
+// resistance works like a deeper well", docs/contacts.md). Pull the two spheres of
+// an attached pair apart with a constant force f each. Their radial relative
+// velocity obeys (m/2) dw/dt = f - c(s) w, so where the film relaxes fast against
+// the crossing of the well (tau = m / (2 c) = 430 steps here, the crossing
+// ~4000) the pair creeps at w = f / c(s) and meets the edge s = 2 delta at about
+// f / c(2 delta). It escapes only when that reaches 2 du: a bond holds up to
+// f* = 2 du c(2 delta), proportional to the close-pair resistance, not to the
+// well's depth alone. Below f* it stays attached, bouncing at the edge. (The
+// threshold is sharp: 0.93 f* holds and 1.07 f* escapes as well.)
+TEST(RadialLubrication, AWellBondHoldsUpToTwiceDuTimesTheEdgeResistance) {
+  const double du = 2e-5, delta = 0.025 * kA, edge_gap = 2 * delta;
+  const RadialLubrication lub({.viscosity = kNu});
+  const double f_star = 2 * du * lub.coefficient(edge_gap, kA);
+  for (const double ratio : {0.8, 1.25}) {
+    auto pair = pair_at_gap(delta, Vec3::UnitX(), Vec3::Zero(), Vec3::Zero());
+    const double m = pair.mass(), dt = 1.0;
+    events::DirectInteractions contacts({.escape_velocity = du, .well_width = delta});
+    contacts.set_attached_pairs({{0, 1}});
+    double max_gap = 0;
+    for (int step = 0; step < 20000 && contacts.attached_count() == 1; ++step) {
+      pair.velocity[0].x() -= ratio * f_star * dt / m;
+      pair.velocity[1].x() += ratio * f_star * dt / m;
+      lub.apply(pair, kBox, dt);
+      contacts.advance(pair, kBox, dt);
+      if (contacts.attached_count() == 1)
+        max_gap = std::max(max_gap, (pair.position[1] - pair.position[0]).norm() - 2 * kA);
+    }
+    SCOPED_TRACE(testing::Message() << "f / f* = " << ratio);
+    if (ratio < 1) {
+      EXPECT_EQ(contacts.counters().escapes, 0u);
+      EXPECT_EQ(contacts.attached_count(), 1u);
+      EXPECT_GT(contacts.counters().edge_bounces, 10u);  // pressed against the edge
+      EXPECT_LE(max_gap, edge_gap * (1 + 1e-12));
+    } else {
+      EXPECT_EQ(contacts.counters().escapes, 1u);
+      EXPECT_EQ(contacts.counters().edge_bounces, 0u);  // out at the first arrival
+    }
+  }
+}
+
 TEST(RadialLubrication, RefusesBadParameters) {
   EXPECT_THROW(RadialLubrication({.viscosity = 0}), std::invalid_argument);
   EXPECT_THROW(RadialLubrication({.onset_gap = 0.1, .saturation_gap = 0.2}), std::invalid_argument);
