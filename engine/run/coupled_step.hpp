@@ -7,7 +7,8 @@
 //   fluid              collision and streaming with those forces
 //   spheres            velocities from the hydrodynamic force and torque, net
 //                      gravity and the inside-liquid momentum change
-//   (health)           every sphere's speed, before anything moves them
+//   (health)           every sphere's speed, before anything moves them, and
+//                      the coupling's period-2 oscillation (coupling_monitor.hpp)
 //   lubrication        radial lubrication below s0, implicit per pair
 //   events             collisions and square wells while the spheres move to
 //                      the end of the step; without contacts a ballistic move
@@ -26,6 +27,7 @@
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lubrication/radial_lubrication.hpp"
+#include "engine/run/coupling_monitor.hpp"
 #include "engine/run/timed_stages.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
 
@@ -64,9 +66,17 @@ struct Liquid {
 // 0.3 (Ma ~ 0.5) the lattice cannot carry the flow around it.
 inline constexpr double kMaxSphereSpeed = 0.3;
 
+// Surface gap (over a) within which a neighbour counts as close in a blow-up
+// diagnosis: the lubrication onset, where kernels of the two spheres overlap.
+inline constexpr double kCrowdedGapOverA = 0.2;
+
+// The number of other spheres whose surfaces are within `gap` of sphere i's.
+int close_neighbours(const spheres::SphereSet& s, const spheres::PeriodicBox& box, std::size_t i,
+                     double gap);
+
 // Empty when every sphere's speed is finite and below kMaxSphereSpeed, else
-// what went wrong.
-std::string sphere_health(const spheres::SphereSet& s);
+// what went wrong, with how crowded the runaway sphere was.
+std::string sphere_health(const spheres::SphereSet& s, const spheres::PeriodicBox& box);
 
 template <class Real>
 class CoupledStep {
@@ -90,6 +100,13 @@ class CoupledStep {
     // there is a liquid, events always (0 s without contacts).
     if (modules_.liquid) {
       liquid_ = std::make_unique<Liquid<Real>>(c);
+      if (modules_.spheres_move) {
+        const double a = c.numerics.radius_cells;
+        const auto& external = liquid_->dynamics.external;
+        const double volume = 4.0 / 3.0 * M_PI * a * a * a;
+        coupling_ = std::make_unique<CouplingMonitor>(
+            (external.net_gravity - external.liquid_body_force * volume).norm());
+      }
       ib_stage_ = stages.declare(stage_name::immersed_boundary);
       fluid_stage_ = stages.declare(stage_name::fluid);
       lubrication_stage_ = stages.declare(stage_name::lubrication);
@@ -118,7 +135,15 @@ class CoupledStep {
     }
     // O(N), well under 1 % of a step
     if (modules_.spheres_move) {
-      std::string sick = sphere_health(s);
+      std::string sick = sphere_health(s, box_);
+      if (!sick.empty()) return sick;
+    }
+    if (coupling_) {
+      const Liquid<Real>& l = *liquid_;
+      loads_.resize(s.size());
+      for (std::size_t i = 0; i < s.size(); ++i)  // per step: dt = 1
+        loads_[i] = l.ib.force()[i] + l.ib.internal_momentum_change()[i];
+      std::string sick = coupling_->observe(loads_);
       if (!sick.empty()) return sick;
     }
     if (modules_.lubrication)
@@ -135,6 +160,8 @@ class CoupledStep {
   events::DirectInteractions& contacts() { return contacts_; }
   const events::DirectInteractions& contacts() const { return contacts_; }
   Liquid<Real>* liquid() { return liquid_.get(); }
+  // The coupling monitor of scenes with a liquid and moving spheres, else null.
+  const CouplingMonitor* coupling() const { return coupling_.get(); }
   const Liquid<Real>* liquid() const { return liquid_.get(); }
 
  private:
@@ -143,6 +170,8 @@ class CoupledStep {
   events::DirectInteractions contacts_;
   const lubrication::RadialLubrication lubrication_;
   std::unique_ptr<Liquid<Real>> liquid_;
+  std::unique_ptr<CouplingMonitor> coupling_;
+  std::vector<spheres::Vec3> loads_;
   TimedStages& stages_;
   TimedStages::Id ib_stage_ = 0, fluid_stage_ = 0, spheres_stage_ = 0, lubrication_stage_ = 0,
                   events_stage_ = 0;

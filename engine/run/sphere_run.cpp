@@ -74,9 +74,10 @@ void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
   for (auto& v : s.velocity) v -= mean;
 }
 
-std::string health(const spheres::SphereSet& s, double liquid_mass) {
+std::string health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
+                   double liquid_mass) {
   if (!std::isfinite(liquid_mass)) return "the liquid mass is no longer finite";
-  return sphere_health(s);
+  return sphere_health(s, box);
 }
 
 // One sample at s.step: a row of the time series, a row of phi(x, t) and, in
@@ -111,7 +112,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
                          .collisions = static_cast<double>(step.contacts().counters().collisions)};
   if (Liquid<Real>* liquid = step.liquid()) {
     const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
-    std::string sick = health(s.spheres, l.mass);
+    std::string sick = health(s.spheres, step.box(), l.mass);
     if (!sick.empty()) return sick;
     const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
                                                             c.derived.phi_realised);
@@ -214,7 +215,9 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                               std::to_string(s.step / c.derived.convective_time) + ")",
                           what,
                           "U_inf too high for the Mach limit, a viscosity too small for the "
-                          "resolution, or a density ratio near 1");
+                          "resolution, a density ratio near 1, or the coupling's period-2 "
+                          "oscillation (measured with the paper's IB method at a = 4, nu = 0.01; "
+                          "docs/numerics.md: a larger viscosity or the one-sweep option runs)");
   };
 
   while (!done) {
@@ -244,7 +247,8 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     const bool stop_now = shell.stop_requested(s.step);
     if (!done && (stop_now || shell.checkpoint_due(s.step, c.protocol.checkpoint_every_s))) {
       // only a healthy state is checkpointed: the last good one is never replaced by a bad one
-      const std::string sick = health(s.spheres, liquid ? liquid->fluid.total_mass() : 0.0);
+      const std::string sick =
+          health(s.spheres, step.box(), liquid ? liquid->fluid.total_mass() : 0.0);
       if (!sick.empty()) return fail(sick);
       stages.run(checkpoint_stage, [&] {
         write_checkpoint(o.out_dir, c, s, protocol, step.contacts(), liquid,
@@ -272,6 +276,14 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
 
   // ---- output and result.json ----------------------------------------------------
   StatisticsSummary summary = summarise(c, s, protocol, step.contacts(), worst_momentum_drift);
+  if (const CouplingMonitor* m = step.coupling())
+    summary.observables["coupling_oscillation"] = {
+        {"worst_window", m->worst_window()},
+        {"limit", CouplingMonitor::kFlipLimit},
+        {"window_steps", CouplingMonitor::kWindowSteps},
+        {"what",
+         "largest fraction of sphere-steps, per window since this invocation started, whose "
+         "hydrodynamic load exceeded 10 net weights and had reversed 3 steps in a row"}};
   stages.run(output_stage, [&] {
     write_series(o.out_dir, s, slabs, summary.distributions);
     if (liquid) write_fields(o.out_dir, liquid->fluid);

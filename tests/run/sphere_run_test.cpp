@@ -14,6 +14,8 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/run/coupled_step.hpp"
+#include "engine/run/coupling_monitor.hpp"
 #include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
@@ -111,6 +113,65 @@ TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
     EXPECT_NEAR(row_mean, c.derived.phi_realised, 1e-12) << "sample " << row;
   }
   fs::remove_all(dir);
+}
+
+// The blow-up diagnosis names how crowded the runaway sphere was (inside an
+// aggregate the coupling of close spheres is the suspect, docs/numerics.md).
+// Hand-placed, a = 4 in a 40^3 box: sphere 1 touches sphere 0 (gap 0.1 a),
+// sphere 2 sits across the periodic x boundary at gap 0.5 a (not close),
+// sphere 3 across the z boundary at gap 0.15 a (close through the image).
+TEST(SphereHealth, ARunawaySphereIsReportedWithItsCloseNeighbours) {
+  spheres::SphereSet s;
+  s.radius = 4;
+  s.density_ratio = 4;
+  s.resize(4);
+  const spheres::PeriodicBox box{spheres::Vec3(40, 40, 40)};
+  s.position = {{1, 20, 1}, {9.4, 20, 1}, {40 - 9, 20, 1}, {1, 20, 40 - 7.6}};
+  EXPECT_EQ(close_neighbours(s, box, 0, 0.2 * s.radius), 2);
+  EXPECT_EQ(close_neighbours(s, box, 2, 0.2 * s.radius), 0);
+  EXPECT_EQ(sphere_health(s, box), "");
+  s.velocity[0] = spheres::Vec3(0.2, 0.25, 0);  // |v| = 0.32 > 0.3
+  const std::string sick = sphere_health(s, box);
+  EXPECT_NE(sick.find("sphere 0 moves at 0.32"), std::string::npos) << sick;
+  EXPECT_NE(sick.find("with 2 other spheres within 0.2 a of its surface"), std::string::npos)
+      << sick;
+  s.velocity[0] = spheres::Vec3::Zero();
+  s.velocity[2].x() = NAN;
+  EXPECT_NE(sphere_health(s, box).find("sphere 2 has a non-finite velocity, with 0 other spheres"),
+            std::string::npos);
+}
+
+// The coupling monitor counts, per 500-step window, the sphere-steps whose load
+// exceeds 10 net weights and has reversed 3 steps in a row. Hand-counted with
+// 100 spheres of weight 1: one sphere flipping +-20 every step flips from its
+// second step on, so steps 3..499 count: 497 in 50 000 sphere-steps, 0.00994
+// > 1e-3: stopped. Flipping at 5 weights, a steady large load and a spike
+// out and back (a collision: two flips) are not counted at all.
+TEST(CouplingMonitor, APeriodTwoFlipOfLargeLoadsStopsTheRunAndNothingElseDoes) {
+  auto window = [](auto load_of) {
+    CouplingMonitor m(1.0);
+    std::vector<spheres::Vec3> loads(100, spheres::Vec3(0.5, 0, 0));
+    std::string said;
+    for (int step = 0; step < CouplingMonitor::kWindowSteps; ++step) {
+      loads[7] = load_of(step);
+      said = m.observe(loads);
+      if (step + 1 < CouplingMonitor::kWindowSteps) {
+        EXPECT_EQ(said, "") << "step " << step;
+      }
+    }
+    return std::make_pair(said, m.worst_window());
+  };
+  const auto flipping = window([](int t) { return spheres::Vec3(t % 2 ? 20 : -20, 3, 0); });
+  EXPECT_NE(flipping.first.find("coupling oscillates"), std::string::npos) << flipping.first;
+  EXPECT_NEAR(flipping.second, 497.0 / 50000.0, 1e-15);
+  const auto small = window([](int t) { return spheres::Vec3(t % 2 ? 5 : -5, 0, 0); });
+  EXPECT_EQ(small.first, "");
+  EXPECT_EQ(small.second, 0.0);
+  const auto steady = window([](int) { return spheres::Vec3(0, 40, 0); });
+  EXPECT_EQ(steady.first, "");
+  const auto isolated = window([](int t) { return spheres::Vec3(t == 300 ? -40 : 40, 0, 0); });
+  EXPECT_EQ(isolated.first, "");
+  EXPECT_EQ(isolated.second, 0.0);
 }
 
 TEST(SphereRun, ScenesWithoutSpheresAreInputErrors) {
