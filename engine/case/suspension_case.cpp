@@ -123,6 +123,16 @@ double schiller_naumann_drag_coefficient(double reynolds) {
   return 24.0 / reynolds * (1.0 + 0.15 * std::pow(reynolds, 0.687));
 }
 
+namespace {
+// The coupling's period-2 oscillation (docs/numerics.md, "Stability floor"):
+// moving spheres, more than one forcing sweep, a < 6 dx, nu below its floor.
+bool multi_sweep_oscillates(const SuspensionCase& c) {
+  return modules_of(c.scene).liquid && modules_of(c.scene).spheres_move &&
+         c.numerics.ib_scheme.sweeps > 1 && c.numerics.radius_cells < 6 &&
+         c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
+}
+}  // namespace
+
 SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   SuspensionCase c;
   InputReader root(document, "");
@@ -219,15 +229,29 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
                                                                        scheme);
     };
-    immersed_boundary::Scheme preset_scheme = p.ib_scheme;
-    if (!c.positions_from.empty() ||
-        c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
-        !calibrated_near(preset_scheme) ||
-        (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
-         pair_gap(preset_scheme) > kNearViscosityFactor &&
-         pair_gap(immersed_boundary::kPaperScheme) < pair_gap(preset_scheme)))
-      preset_scheme = immersed_boundary::kPaperScheme;
-    c.numerics.ib_scheme = read_ib_scheme(num, preset_scheme);
+    auto choose_scheme = [&] {
+      immersed_boundary::Scheme preset_scheme = p.ib_scheme;
+      if (!c.positions_from.empty() ||
+          c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
+          !calibrated_near(preset_scheme) ||
+          (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
+           pair_gap(preset_scheme) > kNearViscosityFactor &&
+           pair_gap(immersed_boundary::kPaperScheme) < pair_gap(preset_scheme)))
+        preset_scheme = immersed_boundary::kPaperScheme;
+      return read_ib_scheme(num, preset_scheme);
+    };
+    c.numerics.ib_scheme = choose_scheme();
+    // By default also stay clear of the multi-sweep coupling's oscillation
+    // (below): raise U_inf until nu reaches its floor, where the Mach limit
+    // allows, and choose again at that viscosity.
+    if (!has_nu && !has_u && multi_sweep_oscillates(c)) {
+      const double u = kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf / (2 * a);
+      if (u <= kMaxSettlingVelocity) {
+        c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
+        c.derived.settling_velocity = u;
+        c.numerics.ib_scheme = choose_scheme();
+      }
+    }
   }
   c.numerics.input_radius_given = num.has("input_radius");
   if (c.numerics.input_radius_given)
@@ -324,6 +348,35 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                            format_value(c.numerics.viscosity) + " was made at " +
                            format_value(c.numerics.calibration_viscosity) +
                            "; `flocsim calibrate --viscosity` makes one for this viscosity");
+  }
+
+  // The coupling's period-2 oscillation (docs/numerics.md): with more than one
+  // forcing sweep below a = 6 dx, moving spheres at nu = 0.01 (the a = 4 stand-in
+  // of the standard box) developed it from t = 26 a/U_inf in all five runs
+  // measured, with and without the well and with either close-pair model: three
+  // blew up, two shook 11-42 % of the spheres every step to the end. nu = 0.0133
+  // and 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01.
+  if (multi_sweep_oscillates(c)) {
+    std::vector<std::string> remedies;
+    const double u_needed = kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf / (2 * a);
+    if (u_needed <= kMaxSettlingVelocity)
+      remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
+    if (c.physics.phi <=
+        immersed_boundary::largest_validated_phi(immersed_boundary::kOneSweepScheme))
+      remedies.push_back(
+          "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
+          "\"sweeps\": 1})");
+    remedies.push_back("raise numerics.a_over_dx to 6");
+    std::string ways;
+    for (std::size_t k = 0; k < remedies.size(); ++k)
+      ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];
+    throw InputError("numerics: viscosity = " + format_value(c.numerics.viscosity) + " with " +
+                     std::to_string(c.numerics.ib_scheme.sweeps) +
+                     " immersed-boundary sweeps at a_over_dx = " + format_value(a) +
+                     ": the coupling of moving spheres is measured to oscillate there below "
+                     "viscosity " +
+                     format_value(kSmallestMultiSweepViscosityBelowA6) + " (docs/numerics.md); " +
+                     ways);
   }
 
   if (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated") {

@@ -24,6 +24,11 @@ namespace flocsim::cases {
 // Sphere and liquid velocities in a settling suspension reach a few U_inf
 // locally; 0.05 keeps those below Ma = 0.2 (|u| = 0.115).
 inline constexpr double kMaxSettlingVelocity = 0.05;
+// Below a = 6 dx with more than one immersed-boundary sweep, the smallest
+// viscosity at which moving spheres were measured free of the coupling's
+// period-2 oscillation (docs/numerics.md): 0.0133 = U_inf 0.02 at a = 4 and
+// Re_inf 12 (clean for 80 a/U_inf, where nu = 0.01 oscillated from t = 26).
+inline constexpr double kSmallestMultiSweepViscosityBelowA6 = 0.04 / 3;
 // Default settling velocity when neither viscosity nor U_inf is given: the
 // middle of the paper's range (0.01-0.03).
 inline constexpr double kDefaultSettlingVelocity = 0.02;

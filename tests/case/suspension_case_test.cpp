@@ -263,6 +263,47 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
                                     HasSubstr("phi = 0.25"), HasSubstr("up to phi = 0.2")));
 }
 
+// Moving spheres with the multi-sweep coupling below a = 6 dx are measured to
+// oscillate at nu = 0.01 (docs/numerics.md): such a case is refused before any
+// work, naming what runs; the one-sweep option, nu = 0.02 and spheres held
+// still are not.
+TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
+  const json paper_ib = {{"marker_spacing", 0.7}, {"sweeps", 2}};
+  const json unstable = {{"scene", "suspension"},
+                         {"fidelity", "draft"},
+                         {"phi", 0.2},
+                         {"Re_inf", 12},
+                         {"du_over_Uinf", 0},
+                         {"numerics", {{"U_inf", 0.015}, {"immersed_boundary", paper_ib}}}};
+  EXPECT_THAT(refusal(unstable),
+              AllOf(HasSubstr("viscosity = 0.01"), HasSubstr("2 immersed-boundary sweeps"),
+                    HasSubstr("a_over_dx = 4"), HasSubstr("below viscosity 0.0133333"),
+                    HasSubstr("U_inf to at least 0.02"), HasSubstr("one-sweep option"),
+                    HasSubstr("a_over_dx to 6")));
+  json one_sweep = unstable;
+  one_sweep["numerics"]["immersed_boundary"] = {{"marker_spacing", 1}, {"sweeps", 1}};
+  EXPECT_EQ(parse_suspension_case(one_sweep).numerics.ib_scheme.sweeps, 1);
+  json viscous = unstable;
+  viscous["numerics"]["U_inf"] = 0.02;  // nu = 0.0133, on the floor
+  EXPECT_NEAR(parse_suspension_case(viscous).numerics.viscosity, 0.04 / 3, 1e-15);
+  json held = unstable;
+  held["scene"] = "fixed-array";
+  held.erase("du_over_Uinf");
+  EXPECT_EQ(parse_suspension_case(held).numerics.ib_scheme.sweeps, 2);
+  // left to defaults, U_inf is raised so that nu sits on the floor (draft at
+  // phi 0.25 takes the paper's method; Re_inf 24 would give nu = 0.00667)
+  const SuspensionCase by_default = parse_suspension_case(
+      {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.25}, {"Re_inf", 24}});
+  EXPECT_EQ(by_default.numerics.ib_scheme.sweeps, 2);
+  EXPECT_NEAR(by_default.numerics.viscosity, 0.04 / 3, 1e-15);
+  EXPECT_NEAR(by_default.derived.settling_velocity, 0.04, 1e-15);
+  // phi above the one-sweep option's validated range: it is not offered
+  json dense = unstable;
+  dense["phi"] = 0.25;
+  EXPECT_THAT(refusal(dense), AllOf(HasSubstr("below viscosity 0.0133333"),
+                                    ::testing::Not(HasSubstr("one-sweep"))));
+}
+
 // Lubrication is the calibrated close-pair model unless the case names
 // Nguyen-Ladd's: it needs the lattice's measured share at the case's a and IB
 // scheme (engine/calibration/pair_resistance.json), and a case without one is
