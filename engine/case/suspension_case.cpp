@@ -131,6 +131,11 @@ bool multi_sweep_oscillates(const SuspensionCase& c) {
          c.numerics.ib_scheme.sweeps > 1 && c.numerics.radius_cells < 6 &&
          c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
 }
+// The U_inf that puts this case's viscosity on that floor.
+double settling_velocity_at_multi_sweep_floor(const SuspensionCase& c) {
+  return kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf /
+         (2 * c.numerics.radius_cells);
+}
 }  // namespace
 
 SuspensionCase parse_suspension_case(const nlohmann::json& document) {
@@ -245,7 +250,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // (below): raise U_inf until nu reaches its floor, where the Mach limit
     // allows, and choose again at that viscosity.
     if (!has_nu && !has_u && multi_sweep_oscillates(c)) {
-      const double u = kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf / (2 * a);
+      const double u = settling_velocity_at_multi_sweep_floor(c);
       if (u <= kMaxSettlingVelocity) {
         c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
         c.derived.settling_velocity = u;
@@ -358,8 +363,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   // and 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01.
   if (multi_sweep_oscillates(c)) {
     std::vector<std::string> remedies;
-    const double u_needed = kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf / (2 * a);
-    if (u_needed <= kMaxSettlingVelocity)
+    const double u_needed = settling_velocity_at_multi_sweep_floor(c);
+    if (has_nu)
+      remedies.push_back("raise numerics.viscosity to at least " +
+                         format_value(kSmallestMultiSweepViscosityBelowA6));
+    else if (u_needed <= kMaxSettlingVelocity)
       remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
     if (c.physics.phi <=
         immersed_boundary::largest_validated_phi(immersed_boundary::kOneSweepScheme))

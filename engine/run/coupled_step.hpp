@@ -66,17 +66,16 @@ struct Liquid {
 // 0.3 (Ma ~ 0.5) the lattice cannot carry the flow around it.
 inline constexpr double kMaxSphereSpeed = 0.3;
 
-// Surface gap (over a) within which a neighbour counts as close in a blow-up
-// diagnosis: the lubrication onset, where kernels of the two spheres overlap.
-inline constexpr double kCrowdedGapOverA = 0.2;
-
 // The number of other spheres whose surfaces are within `gap` of sphere i's.
 int close_neighbours(const spheres::SphereSet& s, const spheres::PeriodicBox& box, std::size_t i,
                      double gap);
 
 // Empty when every sphere's speed is finite and below kMaxSphereSpeed, else
-// what went wrong, with how crowded the runaway sphere was.
-std::string sphere_health(const spheres::SphereSet& s, const spheres::PeriodicBox& box);
+// what went wrong, with how many spheres were within `close_gap_over_a` a of
+// the runaway one (the lubrication onset: a crowded sphere points at the
+// coupling of close spheres rather than at the lattice).
+std::string sphere_health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
+                          double close_gap_over_a);
 
 template <class Real>
 class CoupledStep {
@@ -102,10 +101,10 @@ class CoupledStep {
       liquid_ = std::make_unique<Liquid<Real>>(c);
       if (modules_.spheres_move) {
         const double a = c.numerics.radius_cells;
-        const auto& external = liquid_->dynamics.external;
-        const double volume = 4.0 / 3.0 * M_PI * a * a * a;
         coupling_ = std::make_unique<CouplingMonitor>(
-            (external.net_gravity - external.liquid_body_force * volume).norm());
+            spheres::external_force_per_sphere(liquid_->dynamics.external,
+                                               4.0 / 3.0 * M_PI * a * a * a)
+                .norm());
       }
       ib_stage_ = stages.declare(stage_name::immersed_boundary);
       fluid_stage_ = stages.declare(stage_name::fluid);
@@ -135,7 +134,7 @@ class CoupledStep {
     }
     // O(N), well under 1 % of a step
     if (modules_.spheres_move) {
-      std::string sick = sphere_health(s, box_);
+      std::string sick = sphere_health(s, box_, lubrication_.params().onset_gap);
       if (!sick.empty()) return sick;
     }
     if (coupling_) {

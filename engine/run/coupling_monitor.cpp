@@ -21,11 +21,12 @@ std::string CouplingMonitor::observe(const std::vector<spheres::Vec3>& loads) {
     previous_[s] = h;
   }
   if (++steps_ < kWindowSteps || loads.empty()) return {};
-  const double fraction = static_cast<double>(flips_) /
+  const long count = flips_;
+  const double fraction = static_cast<double>(count) /
                           (static_cast<double>(steps_) * static_cast<double>(loads.size()));
   worst_ = std::max(worst_, fraction);
   flips_ = steps_ = 0;
-  if (fraction <= kFlipLimit) return {};
+  if (fraction <= kFlipLimit || count < kMinimumCount) return {};
   char text[320];
   std::snprintf(text, sizeof text,
                 "the sphere-liquid coupling oscillates: in the last %d steps %.3g of the "

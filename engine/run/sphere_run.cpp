@@ -75,9 +75,9 @@ void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
 }
 
 std::string health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
-                   double liquid_mass) {
+                   double close_gap_over_a, double liquid_mass) {
   if (!std::isfinite(liquid_mass)) return "the liquid mass is no longer finite";
-  return sphere_health(s, box);
+  return sphere_health(s, box, close_gap_over_a);
 }
 
 // One sample at s.step: a row of the time series, a row of phi(x, t) and, in
@@ -112,7 +112,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
                          .collisions = static_cast<double>(step.contacts().counters().collisions)};
   if (Liquid<Real>* liquid = step.liquid()) {
     const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
-    std::string sick = health(s.spheres, step.box(), l.mass);
+    std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a, l.mass);
     if (!sick.empty()) return sick;
     const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
                                                             c.derived.phi_realised);
@@ -247,8 +247,8 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     const bool stop_now = shell.stop_requested(s.step);
     if (!done && (stop_now || shell.checkpoint_due(s.step, c.protocol.checkpoint_every_s))) {
       // only a healthy state is checkpointed: the last good one is never replaced by a bad one
-      const std::string sick =
-          health(s.spheres, step.box(), liquid ? liquid->fluid.total_mass() : 0.0);
+      const std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a,
+                                      liquid ? liquid->fluid.total_mass() : 0.0);
       if (!sick.empty()) return fail(sick);
       stages.run(checkpoint_stage, [&] {
         write_checkpoint(o.out_dir, c, s, protocol, step.contacts(), liquid,
@@ -282,8 +282,11 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
         {"limit", CouplingMonitor::kFlipLimit},
         {"window_steps", CouplingMonitor::kWindowSteps},
         {"what",
-         "largest fraction of sphere-steps, per window since this invocation started, whose "
-         "hydrodynamic load exceeded 10 net weights and had reversed 3 steps in a row"}};
+         "largest fraction of sphere-steps, per window since this invocation started, "
+         "whose hydrodynamic load exceeded " +
+             std::to_string(static_cast<int>(CouplingMonitor::kLargeLoad)) +
+             " net weights and had reversed " + std::to_string(CouplingMonitor::kSustainedFlips) +
+             " steps in a row"}};
   stages.run(output_stage, [&] {
     write_series(o.out_dir, s, slabs, summary.distributions);
     if (liquid) write_fields(o.out_dir, liquid->fluid);

@@ -32,7 +32,7 @@ void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
   const double a = spheres.radius;
   const double mass = spheres.density_ratio * settings.liquid_density * vp;
   const double inertia = 0.4 * mass * a * a;
-  const Vec3 external = settings.external.net_gravity - settings.external.liquid_body_force * vp;
+  const Vec3 external = external_force_per_sphere(settings.external, vp);
   for (std::size_t s = 0; s < n; ++s) {
     // The change of the inside momentum is already a change over one step.
     spheres.velocity[s] +=

@@ -39,6 +39,13 @@ struct SettlingForces {
 SettlingForces settling_forces(std::size_t n, double radius, double density_ratio,
                                double box_volume, double gravity, double liquid_density = 1.0);
 
+// The external force on one sphere of volume V_p: its net gravity and the
+// buoyancy of the liquid's body force, F_g - f V_p (the weight a settling
+// sphere's hydrodynamic force holds up).
+inline Vec3 external_force_per_sphere(const SettlingForces& f, double sphere_volume) {
+  return f.net_gravity - f.liquid_body_force * sphere_volume;
+}
+
 struct SphereDynamicsSettings {
   double liquid_density = 1.0;
   SettlingForces external;

@@ -265,7 +265,7 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
 
 // Moving spheres with the multi-sweep coupling below a = 6 dx are measured to
 // oscillate at nu = 0.01 (docs/numerics.md): such a case is refused before any
-// work, naming what runs; the one-sweep option, nu = 0.02 and spheres held
+// work, naming what runs; the one-sweep option, nu = 0.0133 and spheres held
 // still are not.
 TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
   const json paper_ib = {{"marker_spacing", 0.7}, {"sweeps", 2}};
@@ -283,6 +283,12 @@ TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
   json one_sweep = unstable;
   one_sweep["numerics"]["immersed_boundary"] = {{"marker_spacing", 1}, {"sweeps", 1}};
   EXPECT_EQ(parse_suspension_case(one_sweep).numerics.ib_scheme.sweeps, 1);
+  // a case that gives the viscosity is told to raise the viscosity
+  json given_nu = unstable;
+  given_nu["numerics"].erase("U_inf");
+  given_nu["numerics"]["viscosity"] = 0.01;
+  EXPECT_THAT(refusal(given_nu), AllOf(HasSubstr("raise numerics.viscosity to at least 0.0133333"),
+                                       ::testing::Not(HasSubstr("U_inf"))));
   json viscous = unstable;
   viscous["numerics"]["U_inf"] = 0.02;  // nu = 0.0133, on the floor
   EXPECT_NEAR(parse_suspension_case(viscous).numerics.viscosity, 0.04 / 3, 1e-15);

@@ -129,16 +129,17 @@ TEST(SphereHealth, ARunawaySphereIsReportedWithItsCloseNeighbours) {
   s.position = {{1, 20, 1}, {9.4, 20, 1}, {40 - 9, 20, 1}, {1, 20, 40 - 7.6}};
   EXPECT_EQ(close_neighbours(s, box, 0, 0.2 * s.radius), 2);
   EXPECT_EQ(close_neighbours(s, box, 2, 0.2 * s.radius), 0);
-  EXPECT_EQ(sphere_health(s, box), "");
+  EXPECT_EQ(sphere_health(s, box, 0.2), "");
   s.velocity[0] = spheres::Vec3(0.2, 0.25, 0);  // |v| = 0.32 > 0.3
-  const std::string sick = sphere_health(s, box);
+  const std::string sick = sphere_health(s, box, 0.2);
   EXPECT_NE(sick.find("sphere 0 moves at 0.32"), std::string::npos) << sick;
   EXPECT_NE(sick.find("with 2 other spheres within 0.2 a of its surface"), std::string::npos)
       << sick;
   s.velocity[0] = spheres::Vec3::Zero();
   s.velocity[2].x() = NAN;
-  EXPECT_NE(sphere_health(s, box).find("sphere 2 has a non-finite velocity, with 0 other spheres"),
-            std::string::npos);
+  EXPECT_NE(
+      sphere_health(s, box, 0.2).find("sphere 2 has a non-finite velocity, with 0 other spheres"),
+      std::string::npos);
 }
 
 // The coupling monitor counts, per 500-step window, the sphere-steps whose load
@@ -172,6 +173,17 @@ TEST(CouplingMonitor, APeriodTwoFlipOfLargeLoadsStopsTheRunAndNothingElseDoes) {
   const auto isolated = window([](int t) { return spheres::Vec3(t == 300 ? -40 : 40, 0, 0); });
   EXPECT_EQ(isolated.first, "");
   EXPECT_EQ(isolated.second, 0.0);
+  // One sphere alone: a brief held flip (10 counts, 2 % of its window) is
+  // above the fraction but below the 50 counts a stop needs; a held one stops.
+  auto alone = [](int flipping_steps) {
+    CouplingMonitor m(1.0);
+    std::string said;
+    for (int t = 0; t < CouplingMonitor::kWindowSteps; ++t)
+      said = m.observe({spheres::Vec3(t < flipping_steps && t % 2 ? -20 : 20, 0, 0)});
+    return said;
+  };
+  EXPECT_EQ(alone(13), "");  // flips at t = 1..12 (12 flips), counted from the third: 10
+  EXPECT_NE(alone(500), "");
 }
 
 TEST(SphereRun, ScenesWithoutSpheresAreInputErrors) {
