@@ -99,13 +99,7 @@ class CoupledStep {
     // there is a liquid, events always (0 s without contacts).
     if (modules_.liquid) {
       liquid_ = std::make_unique<Liquid<Real>>(c);
-      if (modules_.spheres_move) {
-        const double a = c.numerics.radius_cells;
-        coupling_ = std::make_unique<CouplingMonitor>(
-            spheres::external_force_per_sphere(liquid_->dynamics.external,
-                                               4.0 / 3.0 * M_PI * a * a * a)
-                .norm());
-      }
+      if (modules_.spheres_move) coupling_ = std::make_unique<CouplingMonitor>();
       ib_stage_ = stages.declare(stage_name::immersed_boundary);
       fluid_stage_ = stages.declare(stage_name::fluid);
       lubrication_stage_ = stages.declare(stage_name::lubrication);
@@ -142,7 +136,8 @@ class CoupledStep {
       loads_.resize(s.size());
       for (std::size_t i = 0; i < s.size(); ++i)  // per step: dt = 1
         loads_[i] = l.ib.force()[i] + l.ib.internal_momentum_change()[i];
-      std::string sick = coupling_->observe(loads_);
+      std::string sick = coupling_->observe(
+          loads_, spheres::external_force_per_sphere(l.dynamics.external, s.volume()).norm());
       if (!sick.empty()) return sick;
     }
     if (modules_.lubrication)

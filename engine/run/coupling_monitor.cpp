@@ -5,9 +5,7 @@
 
 namespace flocsim::run {
 
-CouplingMonitor::CouplingMonitor(double net_weight) : weight_(net_weight) {}
-
-std::string CouplingMonitor::observe(const std::vector<spheres::Vec3>& loads) {
+std::string CouplingMonitor::observe(const std::vector<spheres::Vec3>& loads, double net_weight) {
   if (previous_.size() != loads.size()) {
     previous_.assign(loads.size(), spheres::Vec3::Zero());
     run_.assign(loads.size(), 0);
@@ -15,7 +13,7 @@ std::string CouplingMonitor::observe(const std::vector<spheres::Vec3>& loads) {
   for (std::size_t s = 0; s < loads.size(); ++s) {
     const spheres::Vec3& h = loads[s];
     const double size = h.norm(), before = previous_[s].norm();
-    const bool flip = size > kLargeLoad * weight_ && h.dot(previous_[s]) < -0.5 * size * before;
+    const bool flip = size > kLargeLoad * net_weight && h.dot(previous_[s]) < -0.5 * size * before;
     run_[s] = flip ? static_cast<unsigned char>(std::min(run_[s] + 1, 255)) : 0;
     if (run_[s] >= kSustainedFlips) ++flips_;
     previous_[s] = h;

@@ -39,20 +39,16 @@ class CouplingMonitor {
   // settling sphere) are not stopped by a single event.
   static constexpr long kMinimumCount = 50;
 
-  // `net_weight`: |W|, the force that holds a settling sphere (gravity minus
-  // buoyancy and the liquid's body force), lattice units.
-  explicit CouplingMonitor(double net_weight);
-
   // One step's hydrodynamic loads H_s (force per step, the inside-momentum
-  // change included). Returns a diagnosis when a window closes above the
-  // limit, else empty.
-  std::string observe(const std::vector<spheres::Vec3>& loads);
+  // change included) and the spheres' net weight |W| (the external force a
+  // settling sphere's load holds up, spheres::external_force_per_sphere).
+  // Returns a diagnosis when a window closes above the limit, else empty.
+  std::string observe(const std::vector<spheres::Vec3>& loads, double net_weight);
 
   // The largest fraction of any closed window (since this start).
   double worst_window() const { return worst_; }
 
  private:
-  double weight_;
   std::vector<spheres::Vec3> previous_;
   std::vector<unsigned char> run_;  // flips in a row, per sphere
   long flips_ = 0, steps_ = 0;

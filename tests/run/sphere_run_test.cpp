@@ -150,12 +150,12 @@ TEST(SphereHealth, ARunawaySphereIsReportedWithItsCloseNeighbours) {
 // out and back (a collision: two flips) are not counted at all.
 TEST(CouplingMonitor, APeriodTwoFlipOfLargeLoadsStopsTheRunAndNothingElseDoes) {
   auto window = [](auto load_of) {
-    CouplingMonitor m(1.0);
+    CouplingMonitor m;  // net weight 1
     std::vector<spheres::Vec3> loads(100, spheres::Vec3(0.5, 0, 0));
     std::string said;
     for (int step = 0; step < CouplingMonitor::kWindowSteps; ++step) {
       loads[7] = load_of(step);
-      said = m.observe(loads);
+      said = m.observe(loads, 1.0);
       if (step + 1 < CouplingMonitor::kWindowSteps) {
         EXPECT_EQ(said, "") << "step " << step;
       }
@@ -176,10 +176,10 @@ TEST(CouplingMonitor, APeriodTwoFlipOfLargeLoadsStopsTheRunAndNothingElseDoes) {
   // One sphere alone: a brief held flip (10 counts, 2 % of its window) is
   // above the fraction but below the 50 counts a stop needs; a held one stops.
   auto alone = [](int flipping_steps) {
-    CouplingMonitor m(1.0);
+    CouplingMonitor m;  // net weight 1
     std::string said;
     for (int t = 0; t < CouplingMonitor::kWindowSteps; ++t)
-      said = m.observe({spheres::Vec3(t < flipping_steps && t % 2 ? -20 : 20, 0, 0)});
+      said = m.observe({spheres::Vec3(t < flipping_steps && t % 2 ? -20 : 20, 0, 0)}, 1.0);
     return said;
   };
   EXPECT_EQ(alone(13), "");  // flips at t = 1..12 (12 flips), counted from the third: 10
