@@ -28,4 +28,38 @@ inline std::optional<double> paper_mean_aggregate_size(double phi, double re_inf
   return std::nullopt;
 }
 
+// What the paper states about the normalised aggregate size <n_a>/<n_a>0 (its
+// discussion of Fig. 12): at phi = 0.12 the cases (Re_inf, du/U_inf) = (72, 0.03),
+// (24, 0.025), (12, 0.02) and (6, 0.05) all have about 2.3; at phi = 0.20 the
+// cases (48, 0.03), (12, 0.025) and (6, 0.02) about 7.6. <n_a> grows with du at
+// fixed phi and Re_inf (the paper's Figs. 9 and 10: 4.88 < 11.9 < 59.4) while
+// <n_a>0 does not depend on du, so one stated point bounds the ratio at every
+// other du of its (phi, Re_inf): at most the stated value below that du, at
+// least above it. That is all the text gives; a bound, never a value.
+struct PaperNormalisedSize {
+  enum class Relation { kAbout, kAtMost, kAtLeast };
+  Relation relation;
+  double value;      // the stated <n_a>/<n_a>0
+  double du_stated;  // the du/U_inf of the stated case
+};
+
+inline std::optional<PaperNormalisedSize> paper_normalised_size(double phi, double re_inf,
+                                                                double du) {
+  struct Stated {
+    double phi, re_inf, du, value;
+  };
+  static constexpr Stated kStated[] = {
+      {0.12, 72, 0.03, 2.3}, {0.12, 24, 0.025, 2.3}, {0.12, 12, 0.02, 2.3}, {0.12, 6, 0.05, 2.3},
+      {0.2, 48, 0.03, 7.6},  {0.2, 12, 0.025, 7.6},  {0.2, 6, 0.02, 7.6}};
+  auto same = [](double x, double y) { return std::abs(x - y) <= 1e-9 * std::abs(y); };
+  if (!(du > 0)) return std::nullopt;  // the ratio is 1 by definition at du = 0
+  for (const Stated& s : kStated) {
+    if (!same(phi, s.phi) || !same(re_inf, s.re_inf)) continue;
+    using R = PaperNormalisedSize::Relation;
+    const R relation = same(du, s.du) ? R::kAbout : du < s.du ? R::kAtMost : R::kAtLeast;
+    return PaperNormalisedSize{relation, s.value, s.du};
+  }
+  return std::nullopt;
+}
+
 }  // namespace flocsim::postprocess

@@ -150,6 +150,7 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
     row.n_a_paper = paper_mean_aggregate_size(r.phi, r.re_inf, r.du);
     // the paper gives no error: the ratio carries flocsim's alone
     if (row.n_a_paper && r.n_a) row.n_over_paper = ratio(*r.n_a, {*row.n_a_paper, 0.0});
+    row.n_over_n0_paper = paper_normalised_size(r.phi, r.re_inf, r.du);
     // The same input case may have resolved to other models under another
     // version (a changed default): such a pair is not a ratio of one model.
     auto same_models = [&r](const RunSummary* b) {
@@ -302,6 +303,19 @@ std::string stationary_text(const RunSummary& r) {
   return s;
 }
 
+// "about 7.6" at the stated case's own du, "at most 7.6 (stated at du 0.025)"
+// below it, "at least ..." above: words, which every format carries unescaped.
+std::string paper_bound_text(const PaperNormalisedSize& p) {
+  using R = PaperNormalisedSize::Relation;
+  char b[80];
+  if (p.relation == R::kAbout)
+    std::snprintf(b, sizeof b, "about %g", p.value);
+  else
+    std::snprintf(b, sizeof b, "%s %g (stated at du %g)",
+                  p.relation == R::kAtMost ? "at most" : "at least", p.value, p.du_stated);
+  return b;
+}
+
 std::string window_text(const RunSummary& r) {
   if (r.window_end <= r.window_start) return "";
   char b[64];
@@ -326,6 +340,7 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
             "n_a_over_n_a0",
             "n_a_paper",
             "n_a_over_paper",
+            "n_a_over_n_a0_paper",
             "U_over_Uinf",
             "C_sph",
             "Re_T",
@@ -336,8 +351,8 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
             "run",
             "baseline",
             "note"},
-           {false, false, false, true, true,  true,  true,  true,  true,  true,  false,
-            true,  true,  true,  true, false, false, false, false, false, false, false});
+           {false, false, false, true, true,  true,  true,  true,  true,  true,  false, true,
+            false, true,  true,  true, false, false, false, false, false, false, false});
   for (const AggregationRow& row : rows) {
     const RunSummary& r = *row.run;
     const RunSummary* b = row.baseline;
@@ -356,6 +371,7 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
     else
       w.text("");
     w.measured(row.n_over_paper);
+    w.text(row.n_over_n0_paper ? paper_bound_text(*row.n_over_n0_paper) : "");
     w.measured(r.U_over_Uinf);
     w.measured(r.C_sph);
     w.measured(r.Re_T);
@@ -427,6 +443,7 @@ All quantities are dimensionless (paper section 2 and docs/model.md).
 | n_a_over_n_a0 | <n_a> / <n_a>0 |
 | n_a_paper | the paper's <n_a> where its text states one (Fig. 9: phi 0.2, Re_inf 12, du/U_inf 0.01, 0.02, 0.03; a = 6, N = 1320; no error given) |
 | n_a_over_paper | n_a / n_a_paper, with flocsim's error only |
+| n_a_over_n_a0_paper | the paper's <n_a>/<n_a>0 for this phi and Re_inf where its text states one (about 2.3 at phi 0.12 for (Re_inf, du/U_inf) = (72, 0.03), (24, 0.025), (12, 0.02), (6, 0.05); about 7.6 at phi 0.20 for (48, 0.03), (12, 0.025), (6, 0.02)): "about" at the stated du; at another du a bound, "at most" below it and "at least" above it, because <n_a> grows with du while <n_a>0 does not depend on it |
 | U_over_Uinf | U / U_inf |
 | C_sph | contacts per sphere: other centres within 2(a + delta) |
 | Re_T | T^(1/2) 2a / nu, T the granular temperature |

@@ -20,6 +20,7 @@
 
 #include "db/results_db.hpp"
 #include "orchestrator/report.hpp"
+#include "postprocess/paper_values.hpp"
 
 namespace flocsim::postprocess {
 
@@ -65,6 +66,9 @@ struct AggregationRow {
   std::optional<Measured> F_over_F0, n_over_n0;
   std::optional<double> n_a_paper;       // the paper's stated <n_a> for this case, if any
   std::optional<Measured> n_over_paper;  // <n_a> / n_a_paper (flocsim's error only)
+  // the paper's statement on <n_a>/<n_a>0 for this (phi, Re_inf): a value at its
+  // own du, a bound at any other (paper_values.hpp)
+  std::optional<PaperNormalisedSize> n_over_n0_paper;
 };
 // One row per run with du/U_inf > 0, paired where a completed baseline exists.
 std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs);

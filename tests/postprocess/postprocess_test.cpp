@@ -166,6 +166,11 @@ TEST_F(Post, AggregationTableEqualsAHandCalculation) {
   EXPECT_EQ(*rows[0].n_a_paper, 11.9);
   EXPECT_NEAR(rows[0].n_over_paper->mean, 0.6722689076, 1e-9);
   EXPECT_NEAR(*rows[0].n_over_paper->error, 0.0336134454, 1e-9);
+  // The paper states <n_a>/<n_a>0 of about 7.6 at du 0.025 for this (phi,
+  // Re_inf): at du 0.02 its ratio is at most that.
+  ASSERT_TRUE(rows[0].n_over_n0_paper.has_value());
+  EXPECT_EQ(rows[0].n_over_n0_paper->relation, PaperNormalisedSize::Relation::kAtMost);
+  EXPECT_EQ(rows[0].n_over_n0_paper->value, 7.6);
   std::ostringstream md, csv, tex;
   write_aggregation(rows, "md", md);
   write_aggregation(rows, "csv", csv);
@@ -175,6 +180,8 @@ TEST_F(Post, AggregationTableEqualsAHandCalculation) {
   EXPECT_THAT(csv.str(), HasSubstr(",0.75,0.03181980515,"));  // full precision in CSV
   EXPECT_THAT(tex.str(), HasSubstr("$0.75 \\pm 0.03$"));
   EXPECT_THAT(tex.str(), HasSubstr("\\toprule"));
+  EXPECT_THAT(md.str(), HasSubstr("| at most 7.6 (stated at du 0.025) |"));
+  EXPECT_THAT(csv.str(), HasSubstr(",at most 7.6 (stated at du 0.025),"));
 }
 
 // The paper states <n_a> only for phi 0.2, Re_inf 12 at du/U_inf 0.01, 0.02,
@@ -187,6 +194,33 @@ TEST(PaperValues, OnlyTheStatedCasesHaveAPublishedAggregateSize) {
   EXPECT_FALSE(paper_mean_aggregate_size(0.2, 24, 0.02).has_value());
   EXPECT_FALSE(paper_mean_aggregate_size(0.12, 12, 0.02).has_value());
   EXPECT_FALSE(paper_mean_aggregate_size(0.2, 12, 0).has_value());
+}
+
+// The paper's discussion of Fig. 12 states <n_a>/<n_a>0 of about 2.3 (phi
+// 0.12) and 7.6 (phi 0.20) for named (Re_inf, du/U_inf) cases. Since <n_a>
+// grows with du and <n_a>0 does not depend on it, a smaller du of the same
+// (phi, Re_inf) is bounded above by the stated value and a larger one below;
+// another (phi, Re_inf), or du = 0, gets nothing.
+TEST(PaperValues, TheStatedNormalisedSizeBoundsTheOtherWellStrengths) {
+  using R = PaperNormalisedSize::Relation;
+  const auto at = [](double phi, double re, double du) {
+    return paper_normalised_size(phi, re, du);
+  };
+  ASSERT_TRUE(at(0.2, 12, 0.025));
+  EXPECT_EQ(at(0.2, 12, 0.025)->relation, R::kAbout);
+  EXPECT_EQ(at(0.2, 12, 0.025)->value, 7.6);
+  EXPECT_EQ(at(0.2, 12, 0.01)->relation, R::kAtMost);
+  EXPECT_EQ(at(0.2, 12, 0.02)->relation, R::kAtMost);
+  EXPECT_EQ(at(0.2, 12, 0.03)->relation, R::kAtLeast);
+  EXPECT_EQ(at(0.2, 12, 0.03)->du_stated, 0.025);
+  EXPECT_EQ(at(0.2, 6, 0.02)->relation, R::kAbout);
+  EXPECT_EQ(at(0.2, 48, 0.02)->relation, R::kAtMost);
+  EXPECT_EQ(at(0.12, 6, 0.03)->relation, R::kAtMost);  // stated at du 0.05
+  EXPECT_EQ(at(0.12, 6, 0.03)->value, 2.3);
+  EXPECT_EQ(at(0.12, 12, 0.02)->relation, R::kAbout);
+  EXPECT_FALSE(at(0.2, 24, 0.02));
+  EXPECT_FALSE(at(0.25, 12, 0.02));
+  EXPECT_FALSE(at(0.2, 12, 0));
 }
 
 TEST_F(Post, ABaselineThatLeavesDuAtItsDefaultIsFound) {
