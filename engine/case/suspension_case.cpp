@@ -216,6 +216,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     }
   }
   c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
+  c.numerics.inside_liquid = num.choice("inside_liquid", {"measured", "rigid-body"}, "measured");
   {
     // The preset's option where it is validated for this phi (a snapshot's phi
     // is only known later: the paper's method then) and calibrated for this a
@@ -528,6 +529,9 @@ nlohmann::json SuspensionCase::to_json() const {
   if (modules_of(scene).liquid)
     j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.ib_scheme);
   if (numerics.input_radius_given) j["numerics"]["input_radius"] = numerics.input_radius;
+  // written only when not the default, so that every case that predates the
+  // option keeps its identity
+  if (numerics.inside_liquid != "measured") j["numerics"]["inside_liquid"] = numerics.inside_liquid;
   j["protocol"] = {{"stage1_min", protocol.stage1_min},
                    {"stage1_max", protocol.stage1_max},
                    {"stage2_settle", protocol.stage2_settle},

@@ -76,6 +76,13 @@ struct Numerics {
   double radius_cells = 6;  // hydrodynamic radius a / dx
   double viscosity = 0;     // lattice nu (derived when not given)
   double trt_magic = 0.25;
+  // numerics.inside_liquid: how a sphere's equation of motion accounts for the
+  // liquid that stays on the lattice inside it. "measured" (default): the
+  // change of its momentum as the lattice carries it (Kempe & Froehlich 2012;
+  // Breugem 2012). "rigid-body": assumed to move with the sphere, so the
+  // sphere's translation sees the mass m_p - m_liquid (ten Cate et al. 2002,
+  // the method the paper cites), for comparisons; rotation stays measured.
+  std::string inside_liquid = "measured";
   // numerics.immersed_boundary: marker spacing, forcing sweeps, kernel; the
   // preset's default, and only schemes the shipped calibration holds at this a
   immersed_boundary::Scheme ib_scheme;

@@ -57,6 +57,7 @@ struct Liquid {
     dynamics.external = spheres::settling_forces(static_cast<std::size_t>(c.derived.sphere_count),
                                                  c.numerics.radius_cells, c.physics.density_ratio,
                                                  volume, c.derived.gravity);
+    dynamics.rigid_inside_liquid = c.numerics.inside_liquid == "rigid-body";
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
     fluid.enable_force_field();
   }

@@ -33,10 +33,18 @@ void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
   const double mass = spheres.density_ratio * settings.liquid_density * vp;
   const double inertia = 0.4 * mass * a * a;
   const Vec3 external = external_force_per_sphere(settings.external, vp);
+  const double rigid_mass = mass - settings.liquid_density * vp;
+  if (settings.rigid_inside_liquid && !(rigid_mass > 0.0))
+    throw std::invalid_argument(
+        "sphere dynamics: density_ratio = " + std::to_string(spheres.density_ratio) +
+        ": the rigid-body inside liquid needs > 1");
   for (std::size_t s = 0; s < n; ++s) {
     // The change of the inside momentum is already a change over one step.
-    spheres.velocity[s] +=
-        (dt * (loads.force[s] + external) + loads.internal_momentum_change[s]) / mass;
+    if (settings.rigid_inside_liquid)
+      spheres.velocity[s] += dt * (loads.force[s] + external) / rigid_mass;
+    else
+      spheres.velocity[s] +=
+          (dt * (loads.force[s] + external) + loads.internal_momentum_change[s]) / mass;
     spheres.angular_velocity[s] +=
         (dt * loads.torque[s] + loads.internal_angular_momentum_change[s]) / inertia;
   }

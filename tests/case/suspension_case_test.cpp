@@ -107,6 +107,20 @@ TEST(SuspensionCase, ExplicitFieldsOverrideThePreset) {
   EXPECT_EQ(parse_suspension_case(c.to_json()).to_json(), c.to_json());
 }
 
+// numerics.inside_liquid appears in the canonical case only when it is not
+// the default, so every case written before the option keeps its identity.
+TEST(SuspensionCase, RigidBodyInsideLiquidIsCanonicalOnlyWhenChosen) {
+  const json base = {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}};
+  const SuspensionCase plain = parse_suspension_case(base);
+  EXPECT_EQ(plain.numerics.inside_liquid, "measured");
+  EXPECT_FALSE(plain.to_json()["numerics"].contains("inside_liquid"));
+  json d = base;
+  d["numerics"] = {{"inside_liquid", "rigid-body"}};
+  const SuspensionCase rigid = parse_suspension_case(d);
+  EXPECT_EQ(rigid.to_json()["numerics"]["inside_liquid"], "rigid-body");
+  EXPECT_EQ(parse_suspension_case(rigid.to_json()).to_json(), rigid.to_json());
+}
+
 TEST(SuspensionCase, MachLimitIsStatedWhenBroken) {
   // nu = 0.02 at Re_inf = 72, a = 6: U_inf = 72 * 0.02 / 12 = 0.12 > 0.05
   const std::string m = refusal(
@@ -138,6 +152,10 @@ TEST(SuspensionCase, BadInputsAreNamed) {
                                 HasSubstr("\"granular\"")));
   d["scene"] = "fluid";  // a scene, but not one with spheres
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("scene = \"fluid\""), HasSubstr("\"fixed-array\"")));
+  d = base;
+  d["numerics"] = {{"inside_liquid", "rigid"}};
+  EXPECT_THAT(refusal(d),
+              AllOf(HasSubstr("numerics.inside_liquid = \"rigid\""), HasSubstr("\"rigid-body\"")));
   d = base;
   d["density_ratio"] = 0.5;
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("density_ratio = 0.5"), HasSubstr("settle")));

@@ -313,6 +313,31 @@ TEST(SettlingForces, BalanceOfSpecSectionOne) {
   EXPECT_GT(f.liquid_body_force.x(), 0.0);  // liquid pushed up, spheres pulled down (-x)
 }
 
+// One step by hand, a = 2 (V_p = 32 pi / 3), density ratio 4, liquid density 1,
+// no external force, H = (3, 0, 0), inside-liquid momentum change (0.5, 0, 0):
+// measured: du = (H + dP_in) / m_p = 3.5 / (128 pi / 3) = 0.0261117;
+// rigid body: du = H / (m_p - rho V_p) = 3 / (96 pi / 3) = 0.0298416, the
+// measured change ignored. A density ratio of 1 leaves no mass: refused.
+TEST(SphereDynamics, RigidBodyInsideLiquidByHand) {
+  spheres::SphereSet s;
+  s.radius = 2.0;
+  s.density_ratio = 4.0;
+  s.resize(1);
+  const std::vector<Vec3> force{Vec3(3, 0, 0)}, torque{Vec3::Zero()}, dp{Vec3(0.5, 0, 0)},
+      dl{Vec3::Zero()};
+  spheres::SphereDynamicsSettings measured;  // no external force
+  spheres::advance_velocities(s, {force, torque, dp, dl}, measured);
+  EXPECT_NEAR(s.velocity[0].x(), 3.5 / (128 * M_PI / 3), 1e-15);
+  s.velocity[0] = Vec3::Zero();
+  spheres::SphereDynamicsSettings rigid;
+  rigid.rigid_inside_liquid = true;
+  spheres::advance_velocities(s, {force, torque, dp, dl}, rigid);
+  EXPECT_NEAR(s.velocity[0].x(), 3.0 / (96 * M_PI / 3), 1e-15);
+  s.density_ratio = 1.0;
+  EXPECT_THROW(spheres::advance_velocities(s, {force, torque, dp, dl}, rigid),
+               std::invalid_argument);
+}
+
 // Many spheres in one box, spread by both threads: the force the lattice
 // receives equals minus the sum of the sphere forces (momentum), and the
 // previous step's force is fully removed before the next is written.
