@@ -303,16 +303,19 @@ std::string stationary_text(const RunSummary& r) {
   return s;
 }
 
-// "about 7.6" at the stated case's own du, "at most 7.6 (stated at du 0.025)"
-// below it, "at least ..." above: words, which every format carries unescaped.
+// "about 7.6" at the stated case's own du, else the interval its text implies:
+// "at most 2.3", "at least 7.6" or "2.44-7.6" (words and ASCII, which every
+// format carries unescaped).
 std::string paper_bound_text(const PaperNormalisedSize& p) {
-  using R = PaperNormalisedSize::Relation;
   char b[80];
-  if (p.relation == R::kAbout)
-    std::snprintf(b, sizeof b, "about %g", p.value);
+  if (p.about)
+    std::snprintf(b, sizeof b, "about %.3g", p.low);
+  else if (std::isinf(p.high))
+    std::snprintf(b, sizeof b, "at least %.3g", p.low);
+  else if (p.low <= 1)
+    std::snprintf(b, sizeof b, "at most %.3g", p.high);
   else
-    std::snprintf(b, sizeof b, "%s %g (stated at du %g)",
-                  p.relation == R::kAtMost ? "at most" : "at least", p.value, p.du_stated);
+    std::snprintf(b, sizeof b, "%.3g-%.3g", p.low, p.high);
   return b;
 }
 
@@ -443,7 +446,7 @@ All quantities are dimensionless (paper section 2 and docs/model.md).
 | n_a_over_n_a0 | <n_a> / <n_a>0 |
 | n_a_paper | the paper's <n_a> where its text states one (Fig. 9: phi 0.2, Re_inf 12, du/U_inf 0.01, 0.02, 0.03; a = 6, N = 1320; no error given) |
 | n_a_over_paper | n_a / n_a_paper, with flocsim's error only |
-| n_a_over_n_a0_paper | the paper's <n_a>/<n_a>0 for this phi and Re_inf where its text states one (about 2.3 at phi 0.12 for (Re_inf, du/U_inf) = (72, 0.03), (24, 0.025), (12, 0.02), (6, 0.05); about 7.6 at phi 0.20 for (48, 0.03), (12, 0.025), (6, 0.02)): "about" at the stated du; at another du a bound, "at most" below it and "at least" above it, because <n_a> grows with du while <n_a>0 does not depend on it |
+| n_a_over_n_a0_paper | what the paper's text fixes about its <n_a>/<n_a>0 for this phi and Re_inf (its default box, a = 6): "about" its stated value at the stated du (about 2.3 at phi 0.12 for (Re_inf, du/U_inf) = (72, 0.03), (24, 0.025), (12, 0.02), (6, 0.05); about 7.6 at phi 0.20 for (48, 0.03), (12, 0.025), (6, 0.02)); at another du the interval that implies, because <n_a> grows with du while <n_a>0 does not depend on it (at most the stated value below its du, at least above; at phi 0.2, Re_inf 12 also the Fig. 9 values over the implied <n_a>0 range 1.57-4.88) |
 | U_over_Uinf | U / U_inf |
 | C_sph | contacts per sphere: other centres within 2(a + delta) |
 | Re_T | T^(1/2) 2a / nu, T the granular temperature |

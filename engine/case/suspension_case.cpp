@@ -217,6 +217,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   }
   c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
   c.numerics.inside_liquid = num.choice("inside_liquid", {"measured", "rigid-body"}, "measured");
+  if (c.numerics.inside_liquid != "measured" &&
+      !(modules_of(c.scene).liquid && modules_of(c.scene).spheres_move))
+    throw InputError("numerics.inside_liquid = \"" + c.numerics.inside_liquid + "\": scene \"" +
+                     std::string(scene_name(c.scene)) +
+                     "\" has no spheres moving in a liquid; only the default \"measured\" applies");
   {
     // The preset's option where it is validated for this phi (a snapshot's phi
     // is only known later: the paper's method then) and calibrated for this a

@@ -100,7 +100,10 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
           {"relative_to_sphere_momentum",
            worst_momentum_drift / std::max(1e-300, std::abs(mass * c.derived.sphere_count *
                                                             c.derived.settling_velocity))},
-          {"what", "lattice momentum + sum (m_p u_p - P_in), x, minus its first sample"}};
+          {"what", c.numerics.inside_liquid == "rigid-body"
+                       ? "lattice momentum + sum (m_p - rho V_p) u_p (rigid-body inside liquid), "
+                         "x, minus its first sample"
+                       : "lattice momentum + sum (m_p u_p - P_in), x, minus its first sample"}};
   } else {
     const auto samples = window(column::kinetic_energy);
     const auto wells = window(column::well_energy);

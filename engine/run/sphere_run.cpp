@@ -116,10 +116,13 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
     if (!sick.empty()) return sick;
     const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
                                                             c.derived.phi_realised);
-    // lattice momentum + sum (m_p u_p - P_in): constant (sphere_dynamics.hpp)
+    // lattice momentum + sum (m_p u_p - P_in), or with the rigid-body inside
+    // liquid sum (m_p - rho V_p) u_p: constant (sphere_dynamics.hpp)
     double balance = l.lattice_momentum_x;
     for (std::size_t i = 0; i < s.spheres.size(); ++i)
-      balance += mass * s.spheres.velocity[i].x() - liquid->ib.internal_momentum()[i].x();
+      balance += spheres::sphere_balance_momentum(s.spheres, liquid->dynamics, i,
+                                                  liquid->ib.internal_momentum()[i])
+                     .x();
     if (!s.momentum_initial_set) {
       // not 0: the first step has no inside-momentum change, while the
       // inside liquid already carries the half body force f/2 (a constant)

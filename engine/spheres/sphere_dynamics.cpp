@@ -17,6 +17,25 @@ SettlingForces settling_forces(std::size_t n, double radius, double density_rati
   return out;
 }
 
+double translating_mass(const SphereSet& spheres, const SphereDynamicsSettings& settings) {
+  const double vp = spheres.volume();
+  const double mass = spheres.density_ratio * settings.liquid_density * vp;
+  if (!settings.rigid_inside_liquid) return mass;
+  const double rigid_mass = mass - settings.liquid_density * vp;
+  if (!(rigid_mass > 0.0))
+    throw std::invalid_argument(
+        "sphere dynamics: density_ratio = " + std::to_string(spheres.density_ratio) +
+        ": the rigid-body inside liquid needs > 1");
+  return rigid_mass;
+}
+
+Vec3 sphere_balance_momentum(const SphereSet& spheres, const SphereDynamicsSettings& settings,
+                             std::size_t s, const Vec3& inside_momentum) {
+  const double m = translating_mass(spheres, settings);
+  if (settings.rigid_inside_liquid) return m * spheres.velocity[s];
+  return m * spheres.velocity[s] - inside_momentum;
+}
+
 void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
                         const SphereDynamicsSettings& settings, double dt) {
   const std::size_t n = spheres.size();
@@ -33,15 +52,11 @@ void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
   const double mass = spheres.density_ratio * settings.liquid_density * vp;
   const double inertia = 0.4 * mass * a * a;
   const Vec3 external = external_force_per_sphere(settings.external, vp);
-  const double rigid_mass = mass - settings.liquid_density * vp;
-  if (settings.rigid_inside_liquid && !(rigid_mass > 0.0))
-    throw std::invalid_argument(
-        "sphere dynamics: density_ratio = " + std::to_string(spheres.density_ratio) +
-        ": the rigid-body inside liquid needs > 1");
+  const double translating = translating_mass(spheres, settings);
   for (std::size_t s = 0; s < n; ++s) {
     // The change of the inside momentum is already a change over one step.
     if (settings.rigid_inside_liquid)
-      spheres.velocity[s] += dt * (loads.force[s] + external) / rigid_mass;
+      spheres.velocity[s] += dt * (loads.force[s] + external) / translating;
     else
       spheres.velocity[s] +=
           (dt * (loads.force[s] + external) + loads.internal_momentum_change[s]) / mass;

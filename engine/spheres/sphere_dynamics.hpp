@@ -69,6 +69,19 @@ struct HydrodynamicLoads {
   const std::vector<Vec3>& internal_angular_momentum_change;
 };
 
+// The mass the immersed-boundary load H translates: m_p with the measured
+// inside liquid, m_p - rho V_p with the rigid-body form (which must be > 0).
+double translating_mass(const SphereSet& spheres, const SphereDynamicsSettings& settings);
+
+// What is conserved with the liquid, per sphere: d/dt [lattice momentum +
+// sum_s sphere_balance_momentum(s)] = f V_box + N (F_g - f V_p) = 0. With the
+// measured inside liquid m_p u_p - P_in (P_in its inside momentum); with the
+// rigid-body form (m_p - rho V_p) u_p, since the sphere then counts its
+// inside liquid as moving with it. Contacts and lubrication, equal and opposite
+// between equal spheres, keep either sum.
+Vec3 sphere_balance_momentum(const SphereSet& spheres, const SphereDynamicsSettings& settings,
+                             std::size_t s, const Vec3& inside_momentum);
+
 // One forward-Euler step of the velocity and angular velocity of every sphere.
 void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
                         const SphereDynamicsSettings& settings, double dt = 1.0);

@@ -119,6 +119,11 @@ TEST(SuspensionCase, RigidBodyInsideLiquidIsCanonicalOnlyWhenChosen) {
   const SuspensionCase rigid = parse_suspension_case(d);
   EXPECT_EQ(rigid.to_json()["numerics"]["inside_liquid"], "rigid-body");
   EXPECT_EQ(parse_suspension_case(rigid.to_json()).to_json(), rigid.to_json());
+  // a scene whose spheres do not move in a liquid has no use for it
+  json held = {
+      {"scene", "granular"}, {"phi", 0.2}, {"numerics", {{"inside_liquid", "rigid-body"}}}};
+  EXPECT_THAT(refusal(held),
+              AllOf(HasSubstr("numerics.inside_liquid = \"rigid-body\""), HasSubstr("granular")));
 }
 
 TEST(SuspensionCase, MachLimitIsStatedWhenBroken) {
