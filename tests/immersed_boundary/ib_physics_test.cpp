@@ -26,6 +26,21 @@ double force_field_sum(const lattice::FluidLattice<Real>& fluid) {
   return s;
 }
 
+// One step of the coupled time loop for free spheres without contacts: the
+// immersed boundary, the liquid, then the spheres' velocities and positions.
+template <class Real>
+void coupled_step(lattice::FluidLattice<Real>& fluid, immersed_boundary::ImmersedBoundary<Real>& ib,
+                  spheres::SphereSet& s, const spheres::SphereDynamicsSettings& dyn,
+                  const spheres::PeriodicBox& box) {
+  ib.apply(fluid, s);
+  fluid.step();
+  spheres::advance_velocities(s,
+                              {ib.force(), ib.torque(), ib.internal_momentum_change(),
+                               ib.internal_angular_momentum_change()},
+                              dyn);
+  spheres::advance_positions(s, box);
+}
+
 // Settling spheres with the balancing body force: the lattice momentum (the
 // raw sum of c_i f_i, i.e. without the half-force shift of the force just
 // applied) plus sum (m_p u_p - P_in) cannot change (docs/model.md section 1; P_in the
@@ -54,13 +69,7 @@ void momentum_balance(double tolerance, const immersed_boundary::Scheme& scheme 
   const double inside_mass = s.volume();  // liquid density 1
   double drift = 0, scale = 0, initial = 0;
   for (int step = 0; step < 600; ++step) {
-    ib.apply(fluid, s);
-    fluid.step();
-    spheres::advance_velocities(s,
-                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
-                                 ib.internal_angular_momentum_change()},
-                                dyn);
-    spheres::advance_positions(s, box);
+    coupled_step(fluid, ib, s, dyn, box);
     if (step % 50 != 0 && step != 599) continue;
     // Lattice momentum read with half of the force of this step; remove it.
     const double applied =
@@ -126,13 +135,7 @@ void kicked_sphere(bool rigid_inside_liquid) {
   dyn.rigid_inside_liquid = rigid_inside_liquid;
   for (int step = 0; step < 1500; ++step) {
     if (step == 20) s.velocity[0] = Vec3(v0, 0, 0);
-    ib.apply(fluid, s);
-    fluid.step();
-    spheres::advance_velocities(s,
-                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
-                                 ib.internal_angular_momentum_change()},
-                                dyn);
-    spheres::advance_positions(s, box);
+    coupled_step(fluid, ib, s, dyn, box);
   }
   const double mp = s.mass(), vp = s.volume(), vbox = box.volume();
   const double expected =
@@ -222,13 +225,7 @@ void creeping_settling(double a, int L, Vec3 start, int steps, bool rigid_inside
   // (the drag varies slightly as the sphere moves over the lattice).
   double mean = 0;
   for (int step = 0; step < steps; ++step) {
-    ib.apply(fluid, s);
-    fluid.step();
-    spheres::advance_velocities(s,
-                                {ib.force(), ib.torque(), ib.internal_momentum_change(),
-                                 ib.internal_angular_momentum_change()},
-                                dyn);
-    spheres::advance_positions(s, box);
+    coupled_step(fluid, ib, s, dyn, box);
     if (step >= steps / 2) mean += s.velocity[0].x() / (steps - steps / 2);
   }
   std::printf(
