@@ -135,12 +135,9 @@ class CoupledStep {
     if (coupling_) {
       const Liquid<Real>& l = *liquid_;
       loads_.resize(s.size());
-      // the load that accelerates each sphere, as m_p du_p/dt (per step: dt = 1)
-      const double rigid_scale = s.mass() / spheres::translating_mass(s, l.dynamics);
       for (std::size_t i = 0; i < s.size(); ++i)
-        loads_[i] = l.dynamics.rigid_inside_liquid
-                        ? spheres::Vec3(rigid_scale * l.ib.force()[i])
-                        : spheres::Vec3(l.ib.force()[i] + l.ib.internal_momentum_change()[i]);
+        loads_[i] = spheres::liquid_load_per_step(s, l.dynamics, l.ib.force()[i],
+                                                  l.ib.internal_momentum_change()[i]);
       std::string sick = coupling_->observe(
           loads_, spheres::external_force_per_sphere(l.dynamics.external, s.volume()).norm());
       if (!sick.empty()) return sick;

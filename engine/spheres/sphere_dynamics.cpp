@@ -36,6 +36,13 @@ Vec3 sphere_balance_momentum(const SphereSet& spheres, const SphereDynamicsSetti
   return m * spheres.velocity[s] - inside_momentum;
 }
 
+Vec3 liquid_load_per_step(const SphereSet& spheres, const SphereDynamicsSettings& settings,
+                          const Vec3& force, const Vec3& inside_momentum_change) {
+  if (!settings.rigid_inside_liquid) return force + inside_momentum_change;
+  const double mass = spheres.density_ratio * settings.liquid_density * spheres.volume();
+  return mass / translating_mass(spheres, settings) * force;
+}
+
 void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
                         const SphereDynamicsSettings& settings, double dt) {
   const std::size_t n = spheres.size();

@@ -82,6 +82,13 @@ double translating_mass(const SphereSet& spheres, const SphereDynamicsSettings& 
 Vec3 sphere_balance_momentum(const SphereSet& spheres, const SphereDynamicsSettings& settings,
                              std::size_t s, const Vec3& inside_momentum);
 
+// The liquid's load on a sphere over one step, as it moves the sphere, in units
+// of m_p du_p (what the coupling monitor compares with the net weight): the
+// immersed-boundary force H plus the inside-momentum change dP_in with the
+// measured inside liquid; H m_p / (m_p - rho V_p) with the rigid-body form.
+Vec3 liquid_load_per_step(const SphereSet& spheres, const SphereDynamicsSettings& settings,
+                          const Vec3& force, const Vec3& inside_momentum_change);
+
 // One forward-Euler step of the velocity and angular velocity of every sphere.
 void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
                         const SphereDynamicsSettings& settings, double dt = 1.0);

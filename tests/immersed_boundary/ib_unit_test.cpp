@@ -338,6 +338,22 @@ TEST(SphereDynamics, RigidBodyInsideLiquidByHand) {
                std::invalid_argument);
 }
 
+// The load the coupling monitor watches, by hand (a = 2, density ratio 4):
+// measured, H + dP_in = 3 + 0.5 = 3.5; rigid body, H m_p / (m_p - rho V_p) =
+// 3 x 4/3 = 4, the same acceleration as the velocity update above gives.
+TEST(SphereDynamics, LiquidLoadPerStepByHand) {
+  spheres::SphereSet s;
+  s.radius = 2.0;
+  s.density_ratio = 4.0;
+  s.resize(1);
+  spheres::SphereDynamicsSettings measured, rigid;
+  rigid.rigid_inside_liquid = true;
+  EXPECT_NEAR(spheres::liquid_load_per_step(s, measured, Vec3(3, 0, 0), Vec3(0.5, 0, 0)).x(), 3.5,
+              1e-15);
+  EXPECT_NEAR(spheres::liquid_load_per_step(s, rigid, Vec3(3, 0, 0), Vec3(0.5, 0, 0)).x(), 4.0,
+              1e-14);
+}
+
 // Many spheres in one box, spread by both threads: the force the lattice
 // receives equals minus the sum of the sphere forces (momentum), and the
 // previous step's force is fully removed before the next is written.
