@@ -339,6 +339,36 @@ std::string duration_text(double s) {
 }
 }  // namespace
 
+std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_wall_s,
+                                           const std::vector<RunningProgress>& running,
+                                           int waiting) {
+  if (running.empty() && waiting == 0) return std::nullopt;
+  SweepEta eta;
+  eta.lanes = std::max<int>(static_cast<int>(running.size()), 1);
+  for (const RunningProgress& r : running) {
+    if (!r.eta_s) return std::nullopt;
+    eta.remaining_s = std::max(eta.remaining_s, *r.eta_s);
+  }
+  if (waiting == 0) return eta;
+  if (!completed_wall_s.empty()) {
+    double sum = 0;
+    for (double w : completed_wall_s) sum += w;
+    eta.per_run_s = sum / static_cast<double>(completed_wall_s.size());
+  } else {
+    // A whole run at each running attempt's current rate; attempts that have
+    // not yet measured a rate (no progress) say nothing.
+    double sum = 0;
+    int n = 0;
+    for (const RunningProgress& r : running)
+      if (r.fraction > 0 && r.fraction < 1) sum += *r.eta_s / (1 - r.fraction), ++n;
+    if (n == 0) return std::nullopt;
+    eta.per_run_s = sum / n;
+    eta.from_running_rate = true;
+  }
+  eta.remaining_s += waiting * eta.per_run_s / eta.lanes;
+  return eta;
+}
+
 void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_name,
                   std::ostream& out) {
   std::vector<db::SweepRecord> sweeps;
@@ -360,16 +390,16 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
       if (c.runs > 0 || c.status == RunState::kCompleted || c.status == RunState::kPending)
         out << " " << c.status << " " << c.runs;
     out << "\n";
-    // ETA: what running workers say, plus pending work at the mean wall time so far.
-    double wall_sum = 0;
-    int wall_n = 0, waiting = 0, running = 0;
-    double running_eta = 0;
+    std::vector<double> completed_wall_s;
+    int waiting = 0;
     for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
-      if (r.wall_s) wall_sum += *r.wall_s, ++wall_n;
+      if (r.wall_s) completed_wall_s.push_back(*r.wall_s);
       if (r.run.status == RunState::kPending || r.run.status == RunState::kInterrupted ||
           r.run.status == RunState::kLost)
         ++waiting;
     }
+    std::vector<RunningProgress> progress;
+    int running = 0;
     bool header = false;
     for (const db::RunRecord& r : runs) {
       auto it = live.find(r.id);
@@ -394,7 +424,7 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
                     a.job_id.empty() ? "" : (" job " + a.job_id).c_str(),
                     duration_text(now - beat).c_str());
       out << line;
-      running_eta = std::max(running_eta, a.eta_s.value_or(0));
+      progress.push_back({a.fraction.value_or(0), a.eta_s});
     }
     for (const db::RunRecord& r : runs) {
       if (r.status != RunState::kFailed && r.status != RunState::kRefused &&
@@ -407,14 +437,16 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
           << r.attempts << (exhausted ? ", retry limit reached" : "") << "): " << err << "\n";
     }
     if (running > 0 || waiting > 0) {
-      if (wall_n > 0) {
-        const double per_run = wall_sum / wall_n;
-        const int lanes = std::max(running, 1);
-        out << "  ETA: about " << duration_text(running_eta + waiting * per_run / lanes) << " ("
-            << waiting << " waiting at " << duration_text(per_run) << " each, " << lanes
-            << " worker" << (lanes > 1 ? "s" : "") << ")\n";
+      const std::optional<SweepEta> eta = estimate_sweep_eta(completed_wall_s, progress, waiting);
+      if (!eta) {
+        out << "  ETA: unknown until the running runs report progress\n";
+      } else if (waiting == 0) {
+        out << "  ETA: about " << duration_text(eta->remaining_s) << "\n";
       } else {
-        out << "  ETA: unknown until a run completes\n";
+        out << "  ETA: about " << duration_text(eta->remaining_s) << " (" << waiting
+            << " waiting at " << duration_text(eta->per_run_s) << " each"
+            << (eta->from_running_rate ? " at the running rate, no run completed yet" : "") << ", "
+            << eta->lanes << " worker" << (eta->lanes > 1 ? "s" : "") << ")\n";
       }
     }
   }

@@ -42,6 +42,28 @@ struct QueryOptions {
 // Runs the query and writes it to `out`; returns the number of rows written.
 int write_query(db::ResultsDb& db, const QueryOptions& options, std::ostream& out);
 
+// When a sweep will be done, from what its runs report. The time a whole run
+// takes is the mean wall time of the completed runs; before any run has
+// completed, each running attempt's rate extrapolated to a whole run
+// (eta / (1 - fraction): the runs of a sweep share their step count and
+// lattice more often than not, so this is an estimate, said as such).
+struct RunningProgress {
+  double fraction = 0;          // of the run's steps done
+  std::optional<double> eta_s;  // the worker's own estimate for what is left, once it has one
+};
+struct SweepEta {
+  double remaining_s = 0;          // the slowest running run, then the waiting ones
+  double per_run_s = 0;            // 0 when nothing waits
+  int lanes = 1;                   // runs that go at once (the running ones, at least 1)
+  bool from_running_rate = false;  // per_run_s extrapolated, no run completed yet
+};
+// Empty when nothing runs or waits, when a running run has no estimate yet,
+// or when runs wait and neither a completed run nor a running one with
+// progress gives their length.
+std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_wall_s,
+                                           const std::vector<RunningProgress>& running,
+                                           int waiting);
+
 // Counts by state, the running runs with progress and ETA, the failures.
 void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep, std::ostream& out);
 
