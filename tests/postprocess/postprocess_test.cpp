@@ -204,8 +204,9 @@ TEST(PaperValues, OnlyTheStatedCasesHaveAPublishedAggregateSize) {
 // [11.9/7.6, 59.4/7.6] = [1.5658, 7.8158], so [1.5658, 4.88]. Ratios:
 // du 0.01: [4.88/4.88, 4.88 x 7.6/11.9] = [1, 3.1166]; du 0.02: [2.4385, 7.6];
 // du 0.03: [max(7.6, 12.172), 37.936]. Elsewhere only the stated point:
-// phi 0.2, Re_inf 48 (7.6 at 0.03) at du 0.02: [1, 7.6]; phi 0.12, Re_inf 6
-// (2.3 at 0.05) at 0.06: [2.3, inf). Another (phi, Re_inf), or du = 0: nothing.
+// phi 0.2, Re_inf 48 (7.6 at 0.03) at du 0.02: [1, 7.6]; phi 0.12, Re_inf 24
+// (2.3 at 0.025) at 0.03: [2.3, inf). Another (phi, Re_inf), or du = 0: nothing;
+// nor phi 0.12, Re_inf 6, whose stated du (0.05) is outside the paper's range.
 TEST(PaperValues, TheTextBoundsTheNormalisedSize) {
   const auto at = [](double phi, double re, double du) {
     return paper_normalised_size(phi, re, du);
@@ -225,8 +226,9 @@ TEST(PaperValues, TheTextBoundsTheNormalisedSize) {
   EXPECT_FALSE(at(0.2, 12, 0.03)->about);
   EXPECT_EQ(at(0.2, 48, 0.02)->low, 1.0);
   EXPECT_EQ(at(0.2, 48, 0.02)->high, 7.6);
-  EXPECT_EQ(at(0.12, 6, 0.06)->low, 2.3);
-  EXPECT_TRUE(std::isinf(at(0.12, 6, 0.06)->high));
+  EXPECT_EQ(at(0.12, 24, 0.03)->low, 2.3);
+  EXPECT_TRUE(std::isinf(at(0.12, 24, 0.03)->high));
+  EXPECT_FALSE(at(0.12, 6, 0.03));
   EXPECT_FALSE(paper_baseline_range(0.2, 48));  // no stated <n_a> there
   EXPECT_FALSE(at(0.2, 24, 0.02));
   EXPECT_FALSE(at(0.25, 12, 0.02));
