@@ -7,7 +7,7 @@
 //     "description": "...",                 optional
 //     "base": { ...a case... },             the case every run starts from
 //     "axes": { "fluid.viscosity": [0.01, 0.02], "phi": [0.12, 0.2] },
-//     "fidelity": "production",             optional: written to the case field "fidelity"
+//     "fidelity": "paper",                  optional: written to the case field "fidelity"
 //     "max_attempts": 3,                    optional retry limit (failed attempts per run)
 //     "slurm": { "runs_per_task": 4, "time_limit": "01:00:00", "partition": "debug",
 //                "max_parallel": 8, "cpus_per_task": 1 }      optional, --backend slurm only

@@ -7,7 +7,7 @@
 //   run.log         the log
 //   progress.json   heartbeat, rewritten atomically at least every 5 s
 //   checkpoint.h5   latest complete checkpoint (written atomically)
-//   fields.h5/.xdmf field snapshots, when requested
+//   fields/step_NNNNNNNNNN.h5, fields.xdmf  field snapshots, when requested
 //   result.json     written last, atomically, only when the run completed
 #include <filesystem>
 #include <nlohmann/json.hpp>

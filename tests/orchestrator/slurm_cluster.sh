@@ -1,6 +1,6 @@
 #!/bin/sh
-# A private single-node Slurm on loopback for the tests (see
-# /work/shared/notes/slurm-single-node.md in the project notes):
+# A private single-node Slurm on loopback for the tests (docs/orchestrator.md,
+# Slurm backend):
 #   slurm_cluster.sh start PREFIX   writes PREFIX/slurm.conf, starts munged,
 #                                   slurmctld and slurmd; exit 0 once the node is idle
 #   slurm_cluster.sh stop PREFIX    stops what start started
