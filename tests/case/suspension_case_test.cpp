@@ -378,7 +378,7 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
         gap_named || (w.find("factor 4") != std::string::npos &&
                       w.find("--pair-box 12 --marker-spacing 1 --sweeps 1") != std::string::npos);
   EXPECT_TRUE(gap_named);
-  // a = 8: close pairs calibrated for the paper's method only (nu = 0.02), so
+  // a = 8: close pairs calibrated for the paper's method only (nu = 0.01-0.04), so
   // the preset falls back to it from the one-sweep option
   const SuspensionCase a8 = parse_suspension_case(
       {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}});
