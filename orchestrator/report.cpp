@@ -346,7 +346,7 @@ std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_
   SweepEta eta;
   eta.lanes = std::max<int>(static_cast<int>(running.size()), 1);
   for (const RunningProgress& r : running) {
-    if (!r.eta_s) return std::nullopt;
+    if (!r.eta_s || *r.eta_s < 0) return std::nullopt;  // a worker writes -1 before it has a rate
     eta.remaining_s = std::max(eta.remaining_s, *r.eta_s);
   }
   if (waiting == 0) return eta;
@@ -439,9 +439,14 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
     if (running > 0 || waiting > 0) {
       const std::optional<SweepEta> eta = estimate_sweep_eta(completed_wall_s, progress, waiting);
       if (!eta) {
-        out << "  ETA: unknown until the running runs report progress\n";
+        out << (running > 0 ? "  ETA: unknown until the running runs report progress\n"
+                            : "  ETA: unknown until a run completes\n");
       } else if (waiting == 0) {
         out << "  ETA: about " << duration_text(eta->remaining_s) << "\n";
+      } else if (running == 0) {
+        out << "  ETA: about " << duration_text(eta->remaining_s)
+            << " once resumed, one run at a time (" << waiting << " waiting at "
+            << duration_text(eta->per_run_s) << " each; nothing is running now)\n";
       } else {
         out << "  ETA: about " << duration_text(eta->remaining_s) << " (" << waiting
             << " waiting at " << duration_text(eta->per_run_s) << " each"

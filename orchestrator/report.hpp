@@ -49,7 +49,7 @@ int write_query(db::ResultsDb& db, const QueryOptions& options, std::ostream& ou
 // lattice more often than not, so this is an estimate, said as such).
 struct RunningProgress {
   double fraction = 0;          // of the run's steps done
-  std::optional<double> eta_s;  // the worker's own estimate for what is left, once it has one
+  std::optional<double> eta_s;  // the worker's own estimate for what is left (< 0: none yet)
 };
 struct SweepEta {
   double remaining_s = 0;          // the slowest running run, then the waiting ones

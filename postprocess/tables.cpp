@@ -446,7 +446,7 @@ All quantities are dimensionless (paper section 2 and docs/model.md).
 | n_a_over_n_a0 | <n_a> / <n_a>0 |
 | n_a_paper | the paper's <n_a> where its text states one (Fig. 9: phi 0.2, Re_inf 12, du/U_inf 0.01, 0.02, 0.03; a = 6, N = 1320; no error given) |
 | n_a_over_paper | n_a / n_a_paper, with flocsim's error only |
-| n_a_over_n_a0_paper | what the paper's text fixes about its <n_a>/<n_a>0 for this phi and Re_inf (its default box, a = 6): "about" its stated value at the stated du (about 2.3 at phi 0.12 for (Re_inf, du/U_inf) = (72, 0.03), (24, 0.025), (12, 0.02), (6, 0.05); about 7.6 at phi 0.20 for (48, 0.03), (12, 0.025), (6, 0.02)); at another du the interval that implies, because <n_a> grows with du while <n_a>0 does not depend on it (at most the stated value below its du, at least above; at phi 0.2, Re_inf 12 also the Fig. 9 values over the implied <n_a>0 range 1.57-4.88) |
+| n_a_over_n_a0_paper | what the paper's text fixes about its <n_a>/<n_a>0 for this phi and Re_inf (its default box, a = 6): "about" its stated value at the stated du (about 2.3 at phi 0.12 for (Re_inf, du/U_inf) = (72, 0.03), (24, 0.025), (12, 0.02), and (6, 0.05), not used: 0.05 is outside the du range it simulated; about 7.6 at phi 0.20 for (48, 0.03), (12, 0.025), (6, 0.02)); at another du the interval that implies, because <n_a> grows with du while <n_a>0 does not depend on it (at most the stated value below its du, at least above; at phi 0.2, Re_inf 12 also the Fig. 9 values over the implied <n_a>0 range 1.57-4.88) |
 | U_over_Uinf | U / U_inf |
 | C_sph | contacts per sphere: other centres within 2(a + delta) |
 | Re_T | T^(1/2) 2a / nu, T the granular temperature |

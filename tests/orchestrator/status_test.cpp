@@ -54,6 +54,8 @@ TEST(SweepEta, NothingIsClaimedWithoutAnEstimate) {
   EXPECT_FALSE(orc::estimate_sweep_eta({}, {}, 2));  // waiting, no length known
   // a worker that has not reported yet
   EXPECT_FALSE(orc::estimate_sweep_eta({3600}, {{0.0, std::nullopt}}, 1));
+  // the -1 a worker writes before it has a rate
+  EXPECT_FALSE(orc::estimate_sweep_eta({3600}, {{0.5, -1.0}}, 1));
   // an estimate but no progress: no rate for a whole run
   EXPECT_FALSE(orc::estimate_sweep_eta({}, {{0.0, 500.0}}, 1));
   // the last run: its own estimate, whatever the others took
