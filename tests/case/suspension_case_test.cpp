@@ -367,17 +367,15 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
       {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}, {"Re_inf", 12}});
   EXPECT_EQ(draft.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
   // Re_inf 72 at a = 6 (nu = 0.005): the close pairs of both schemes are
-  // calibrated only from nu = 0.02, 4x away, so the faster one runs, warned
+  // calibrated from nu = 0.01, a factor 2 away, so the faster one runs
+  // without a warning
   const SuspensionCase fast = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 72}});
   EXPECT_DOUBLE_EQ(fast.numerics.viscosity, 0.005);
   EXPECT_EQ(fast.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  bool gap_named = false;
+  EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.005, immersed_boundary::kOneSweepScheme), 2.0);
   for (const auto& w : fast.warnings)
-    gap_named =
-        gap_named || (w.find("factor 4") != std::string::npos &&
-                      w.find("--pair-box 12 --marker-spacing 1 --sweeps 1") != std::string::npos);
-  EXPECT_TRUE(gap_named);
+    EXPECT_EQ(w.find("close-pair calibration"), std::string::npos) << w;
   // a = 8: close pairs calibrated for the paper's method only (nu = 0.01-0.04), so
   // the preset falls back to it from the one-sweep option
   const SuspensionCase a8 = parse_suspension_case(
@@ -393,7 +391,7 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   EXPECT_NO_THROW(parse_suspension_case(
       {{"scene", "fixed-array"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}));
   // far from the calibrated viscosities: accepted with a warning naming the gap
-  // (a = 6 entries at nu = 0.02 and 0.04; nu = 0.1 is 2.5x above)
+  // (a = 6 entries at nu = 0.01, 0.02 and 0.04; nu = 0.1 is 2.5x above)
   const SuspensionCase far = parse_suspension_case({{"scene", "suspension"},
                                                     {"fidelity", "paper"},
                                                     {"phi", 0.2},
