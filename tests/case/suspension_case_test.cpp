@@ -366,16 +366,29 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   const SuspensionCase draft = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}, {"Re_inf", 12}});
   EXPECT_EQ(draft.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  // Re_inf 72 at a = 6 (nu = 0.005): the close pairs of both schemes are
-  // calibrated from nu = 0.01, a factor 2 away, so the faster one runs
-  // without a warning
+  // Re_inf 72 at a = 6 (nu = 0.005, the paper grid's lowest): both schemes'
+  // close pairs are calibrated there, so the faster one runs without a warning
   const SuspensionCase fast = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 72}});
   EXPECT_DOUBLE_EQ(fast.numerics.viscosity, 0.005);
   EXPECT_EQ(fast.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.005, immersed_boundary::kOneSweepScheme), 2.0);
+  EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.005, immersed_boundary::kOneSweepScheme), 1.0);
   for (const auto& w : fast.warnings)
     EXPECT_EQ(w.find("close-pair calibration"), std::string::npos) << w;
+  // nu = 0.1 at a = 6: both schemes' highest entry (0.04) is a factor 2.5 away,
+  // so the faster one runs, with a warning naming the gap and its command
+  const SuspensionCase neither = parse_suspension_case({{"scene", "suspension"},
+                                                        {"fidelity", "standard"},
+                                                        {"phi", 0.2},
+                                                        {"Re_inf", 3},
+                                                        {"numerics", {{"viscosity", 0.1}}}});
+  EXPECT_EQ(neither.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  bool gap_named = false;
+  for (const auto& w : neither.warnings)
+    gap_named =
+        gap_named || (w.find("factor 2.5") != std::string::npos &&
+                      w.find("--pair-box 12 --marker-spacing 1 --sweeps 1") != std::string::npos);
+  EXPECT_TRUE(gap_named);
   // a = 8: close pairs calibrated for the paper's method only (nu = 0.01-0.04), so
   // the preset falls back to it from the one-sweep option
   const SuspensionCase a8 = parse_suspension_case(
