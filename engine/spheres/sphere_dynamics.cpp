@@ -17,11 +17,18 @@ SettlingForces settling_forces(std::size_t n, double radius, double density_rati
   return out;
 }
 
+namespace {
+// m_p = rho_p V_p, with rho_p = density_ratio x the liquid's density (the
+// SphereSet's own mass() takes the liquid density as 1).
+double sphere_mass(const SphereSet& spheres, double liquid_density) {
+  return spheres.density_ratio * liquid_density * spheres.volume();
+}
+}  // namespace
+
 double translating_mass(const SphereSet& spheres, const SphereDynamicsSettings& settings) {
-  const double vp = spheres.volume();
-  const double mass = spheres.density_ratio * settings.liquid_density * vp;
+  const double mass = sphere_mass(spheres, settings.liquid_density);
   if (!settings.rigid_inside_liquid) return mass;
-  const double rigid_mass = mass - settings.liquid_density * vp;
+  const double rigid_mass = mass - settings.liquid_density * spheres.volume();
   if (!(rigid_mass > 0.0))
     throw std::invalid_argument(
         "sphere dynamics: density_ratio = " + std::to_string(spheres.density_ratio) +
@@ -39,8 +46,8 @@ Vec3 sphere_balance_momentum(const SphereSet& spheres, const SphereDynamicsSetti
 Vec3 liquid_load_per_step(const SphereSet& spheres, const SphereDynamicsSettings& settings,
                           const Vec3& force, const Vec3& inside_momentum_change) {
   if (!settings.rigid_inside_liquid) return force + inside_momentum_change;
-  const double mass = spheres.density_ratio * settings.liquid_density * spheres.volume();
-  return mass / translating_mass(spheres, settings) * force;
+  return sphere_mass(spheres, settings.liquid_density) / translating_mass(spheres, settings) *
+         force;
 }
 
 void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
@@ -56,7 +63,7 @@ void advance_velocities(SphereSet& spheres, const HydrodynamicLoads& loads,
                                 std::to_string(spheres.density_ratio) + ": must be > 0");
   const double vp = spheres.volume();
   const double a = spheres.radius;
-  const double mass = spheres.density_ratio * settings.liquid_density * vp;
+  const double mass = sphere_mass(spheres, settings.liquid_density);
   const double inertia = 0.4 * mass * a * a;
   const Vec3 external = external_force_per_sphere(settings.external, vp);
   const double translating = translating_mass(spheres, settings);
@@ -78,7 +85,7 @@ void advance_positions(SphereSet& spheres, const PeriodicBox& box, double dt) {
 }
 
 Vec3 sphere_momentum(const SphereSet& spheres, double liquid_density) {
-  const double mass = spheres.density_ratio * liquid_density * spheres.volume();
+  const double mass = sphere_mass(spheres, liquid_density);
   Vec3 p = Vec3::Zero();
   for (const Vec3& u : spheres.velocity) p += mass * u;
   return p;
