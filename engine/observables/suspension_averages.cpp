@@ -1,5 +1,6 @@
 #include "engine/observables/suspension_averages.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -84,6 +85,34 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches) {
   out.batches = batches;
   out.correlation_samples = integrated_correlation_time(series);
   out.error_reliable = static_cast<double>(per) >= 5.0 * out.correlation_samples;
+  return out;
+}
+
+SteadyAverage steady_average(const std::vector<double>& series, int most_batches,
+                             double batch_over_tau, int fewest_reliable_batches) {
+  SteadyAverage out;
+  out.samples = static_cast<long>(series.size());
+  if (series.empty()) return out;
+  const double tau = integrated_correlation_time(series);
+  const long batch_length = std::max(1L, static_cast<long>(std::ceil(batch_over_tau * tau)));
+  const long fit = out.samples / batch_length;
+  if (fit >= 2) {
+    out = batch_means(series, static_cast<int>(std::min<long>(most_batches, fit)));
+    out.error_reliable = out.batches >= fewest_reliable_batches;
+    return out;
+  }
+  // too short for two batches of batch_over_tau correlation times
+  double mean = 0;
+  for (double x : series) mean += x;
+  mean /= static_cast<double>(out.samples);
+  double var = 0;
+  for (double x : series) var += (x - mean) * (x - mean);
+  var /= std::max(1L, out.samples - 1);
+  out.mean = mean;
+  out.error = std::sqrt(var * tau / static_cast<double>(out.samples));
+  out.batches = 0;
+  out.correlation_samples = tau;
+  out.error_reliable = false;
   return out;
 }
 

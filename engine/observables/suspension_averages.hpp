@@ -43,6 +43,18 @@ struct SteadyAverage {
 };
 SteadyAverage batch_means(const std::vector<double>& series, int batches);
 
+// The steady average a run reports: batch means whose batches each span at
+// least `batch_over_tau` integrated correlation times (5: successive batch
+// means then correlate by less than about 1/(2 * 5), so their scatter measures
+// the error), as many as fit up to `most_batches`. Few batches give an honest
+// but itself uncertain error (relative scatter ~ 1/sqrt(2 (B - 1)): 35 % at 5
+// batches), so error_reliable is set only from `fewest_reliable_batches` on. A
+// window shorter than two such batches has no batch-means error: the error is
+// then sigma sqrt(tau / n) from the measured correlation time, batches = 0,
+// and it is flagged unreliable.
+SteadyAverage steady_average(const std::vector<double>& series, int most_batches = 10,
+                             double batch_over_tau = 5.0, int fewest_reliable_batches = 5);
+
 // Integrated autocorrelation time of a series, in samples (see SteadyAverage).
 double integrated_correlation_time(const std::vector<double>& series);
 

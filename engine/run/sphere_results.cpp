@@ -31,13 +31,13 @@ std::vector<double> statistics_window(const SphereRunState& s, long statistics_s
   return out;
 }
 
-// Steady average with its batch-means error over 10 batches (the protocol
-// guarantees at least 20 samples in the window).
+// Steady average with its batch-means error, batches of at least 5
+// correlation times (observables::steady_average; at most 10 batches).
 // The window is also tested for a slow drift (observables::window_drift): a
 // drifting series is reported "stationary": false, with its change over the
 // window, rather than as a bare mean.
 nlohmann::json steady(const std::vector<double>& samples) {
-  const auto a = observables::batch_means(samples, 10);
+  const auto a = observables::steady_average(samples);
   const auto drift = observables::window_drift(samples);
   return {{"mean", a.mean},
           {"error", a.error},

@@ -15,8 +15,11 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4PaperViscosity) {
   expect_total_near_brenner(4, 0.02, kGaps);
 }
 
+// nu = 0.014: between the 0.01 and 0.02 entries, just above the viscosity
+// below which a case with the paper's two-sweep method at a < 6 is refused
+// (its coupling oscillates there; docs/numerics.md).
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4LowViscosity) {
-  expect_total_near_brenner(4, 0.013, kGaps);
+  expect_total_near_brenner(4, 0.014, kGaps);
 }
 
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6) {

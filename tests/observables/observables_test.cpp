@@ -160,6 +160,61 @@ TEST(BatchMeans, ErrorMatchesAnalyticStandardErrorOfCorrelatedSeries) {
   }
 }
 
+TEST(SteadyAverage, BatchesSpanFiveCorrelationTimesAndGiveTheAnalyticError) {
+  // AR(1) with rho = 0.9: tau = (1 + rho)/(1 - rho) = 19 samples. With 20,000
+  // samples, 10 batches of 2,000 samples (105 tau) fit: the error must match
+  // the analytic sqrt(tau / n) (scatter 1/sqrt(2 * 9) = 24 % per series, 7.5 %
+  // averaged over 10 series, so 25 % is over 3 sigma) and be flagged reliable.
+  const long n = 20000;
+  const double tau = (1 + 0.9) / (1 - 0.9);
+  double ratio = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const SteadyAverage a = steady_average(ar1(n, 0.9, seed));
+    EXPECT_EQ(a.batches, 10);
+    EXPECT_TRUE(a.error_reliable);
+    ratio += a.error / std::sqrt(tau / n) / 10;
+  }
+  EXPECT_NEAR(ratio, 1.0, 0.25);
+  // 800 samples (42 tau, like a 400 a/U_inf window with a 10 a/U_inf
+  // correlation time sampled every 0.5): batches of >= 5 measured tau leave
+  // room for at most 8; each batch holds n / batches >= 5 tau samples
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const auto x = ar1(800, 0.9, seed);
+    const SteadyAverage a = steady_average(x);
+    ASSERT_GE(a.batches, 2) << seed;
+    EXPECT_GE(static_cast<double>(800 / a.batches), 5 * a.correlation_samples) << seed;
+    EXPECT_EQ(a.error_reliable, a.batches >= 5) << seed;
+  }
+}
+
+TEST(SteadyAverage, AWindowShorterThanTwoBatchesFallsBackToTheCorrelationTime) {
+  // One slow swing across the window, x_k = cos(pi k / n) plus AR(1) noise of
+  // a tenth of its amplitude: the autocorrelation stays positive to about lag
+  // n / 2, so tau is of order n / 4 and two batches of 5 tau cannot fit. No
+  // batch-means error then: the error is the sample standard deviation times
+  // sqrt(tau / n) with the measured tau, recomputed here by hand, flagged
+  // unreliable.
+  const long n = 600;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    auto x = ar1(n, 0.5, seed);
+    for (long k = 0; k < n; ++k) x[k] = std::cos(M_PI * k / n) + 0.1 * x[k];
+    const SteadyAverage a = steady_average(x);
+    EXPECT_GT(a.correlation_samples, n / 10.0) << seed;
+    EXPECT_EQ(a.batches, 0) << seed;
+    EXPECT_FALSE(a.error_reliable) << seed;
+    double mean = 0, var = 0;
+    for (double v : x) mean += v / n;
+    for (double v : x) var += (v - mean) * (v - mean) / (n - 1);
+    EXPECT_NEAR(a.mean, mean, 1e-12) << seed;
+    EXPECT_NEAR(a.error, std::sqrt(var * a.correlation_samples / n), 1e-12) << seed;
+  }
+  // white noise: tau ~ 1, so the 10 batches of the cap fit and the error is
+  // sigma / sqrt(n) = 0.01 within the 24 % scatter of 10 batches (3 sigma)
+  const SteadyAverage w = steady_average(ar1(10000, 0.0, 4));
+  EXPECT_EQ(w.batches, 10);
+  EXPECT_NEAR(w.error, 0.01, 0.0072);
+}
+
 TEST(Stationarity, DetectsTheEndOfAnExponentialRelaxation) {
   // x(t) = exp(-t / 1000) + noise 0.01: with windows of 500 samples the drift
   // between windows (~exp(-t/1000) * 0.4) exceeds 2 standard errors (~1e-3)

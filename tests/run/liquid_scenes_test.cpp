@@ -64,7 +64,14 @@ TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
        {"U_over_Uinf", "U", "F", "Re", "Re_T", "C_sph", "n_a_mean", "granular_temperature"}) {
     ASSERT_TRUE(obs.contains(key)) << key;
     EXPECT_TRUE(std::isfinite(obs[key]["mean"].get<double>())) << key;
-    EXPECT_EQ(obs[key]["batches"].get<int>(), 10) << key;
+    // batches of at least 5 correlation times, at most 10 (0: window too short)
+    const int batches = obs[key]["batches"].get<int>();
+    EXPECT_LE(batches, 10) << key;
+    if (batches > 0) {
+      EXPECT_GE(obs[key]["samples"].get<double>() / batches,
+                5 * obs[key]["correlation_samples"].get<double>())
+          << key;
+    }
   }
   // the spheres settle (slip along -x relative to the liquid: U > 0) and
   // more slowly than a lone sphere
