@@ -2,7 +2,7 @@
 // square wells) and radial lubrication alone, no fluid, for the paper's
 // largest case: 2112 spheres (phi = 0.32) of a = 6 in a 48a x 24a x 24a box,
 // wells on with du = 0.02 U_inf (U_inf = 0.02), delta = 0.025 a; also
-// phi = 0.20 (1320 spheres), where issue 4 sets the 10 % target.
+// phi = 0.20 (1320 spheres), where the contacts have a 10 % cost target.
 //
 // Between steps the spheres get the velocity update a fluid would give, here
 // an Ornstein-Uhlenbeck relaxation towards a settling velocity of -0.02 e_x

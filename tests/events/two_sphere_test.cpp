@@ -2,7 +2,7 @@
 // "Event-driven direct interactions"): head-on and oblique collisions of the
 // Yamamoto et al. (2001) model for several e and mu_f, capture into the
 // square well, escape at exactly 2 du and bounce just below, plus the
-// robustness rules of issue 4 (touching and round-off overlapping starts,
+// robustness rules of the event engine (touching and round-off overlapping starts,
 // periodic images, the event cap, du = 0 composing no wells, checkpoints).
 //
 // Tolerances: these are single events in double precision, so answers must

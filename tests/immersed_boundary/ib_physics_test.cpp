@@ -165,7 +165,7 @@ TEST(MomentumBalance, EveryKernelAndSweepCountConserves) {
 }
 
 // Simple cubic arrays at a = 6 dx with the calibrated input radius: K within
-// 2 % of Sangani & Acrivos (the requirement) at phi = 0.18 and 0.10.
+// 2 % of Sangani & Acrivos (the accuracy asked of the calibrated IB) at phi = 0.18 and 0.10.
 // The calibration fits one a over chi = 0.35 - 0.7; this checks the fit at
 // box sizes it did not use.
 void array_drag(double a, int L) {

@@ -43,7 +43,7 @@ double array_error(double a, double phi, const immersed_boundary::Scheme& scheme
   return K / K_ref - 1;
 }
 
-// The requirement: within 2 % for phi = 0.01 - 0.2 at a = 6 dx.
+// The accuracy asked of the immersed boundary: within 2 % for phi = 0.01 - 0.2 at a = 6 dx.
 TEST(SimpleCubicArraySweep, Resolution6WithinTwoPercent) {
   for (double phi : {0.01, 0.05, 0.1, 0.2})
     EXPECT_LT(std::abs(array_error(6.0, phi)), 0.02) << "phi " << phi;

@@ -226,7 +226,7 @@ TEST(BrennerPairResistance, FarFieldNearFieldAndAMeasuredValue) {
   // the squeeze film dominates: at s = 1e-4 a the log and constant terms add
   // 2e-4 (0.45 ln 1e4 + ~1.35) = 0.0011 to the leading term's 1
   EXPECT_NEAR(brenner_pair_resistance(1e-4) * 2e-4, 1.0011, 1e-4);
-  // the value quoted for the IB measurement at s = 0.05a: 12.7
+  // the exact value at s = 0.05a (the square well's edge): 12.7
   EXPECT_NEAR(brenner_pair_resistance(0.05), 12.7, 0.05);
   // monotone: closer is stiffer
   double last = 1.0;

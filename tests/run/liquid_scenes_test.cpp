@@ -263,7 +263,7 @@ void expect_sangani_acrivos(const std::string& scene) {
   EXPECT_LT(re, 0.1);  // creeping
   // steady: the window's fluctuation is far below the tolerance
   EXPECT_LT(obs["F"]["error"].get<double>(), 1e-3 * F);
-  // 2 %: the accuracy for arrays after calibration (the calibration
+  // 2 %: the accuracy asked for arrays after calibration (the calibration
   // itself matched K to 0.1 % at a = 4; the liquid-volume average of U over
   // cells outside a adds a discretisation error of about 1 %)
   EXPECT_NEAR(F / expected, 1.0, 0.02);
