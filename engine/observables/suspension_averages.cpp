@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace flocsim::observables {
@@ -90,15 +91,22 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches) {
 
 SteadyAverage steady_average(const std::vector<double>& series, int most_batches,
                              double batch_over_tau, int fewest_reliable_batches) {
+  if (most_batches < 2) throw std::invalid_argument("steady_average: most_batches must be >= 2");
   SteadyAverage out;
   out.samples = static_cast<long>(series.size());
   if (series.empty()) return out;
+  if (std::any_of(series.begin(), series.end(), [](double x) { return !std::isfinite(x); })) {
+    // no average to speak of: say so rather than estimate a correlation time
+    out.mean = out.error = out.correlation_samples = std::numeric_limits<double>::quiet_NaN();
+    return out;
+  }
   const double tau = integrated_correlation_time(series);
   const long batch_length = std::max(1L, static_cast<long>(std::ceil(batch_over_tau * tau)));
   const long fit = out.samples / batch_length;
   if (fit >= 2) {
     out = batch_means(series, static_cast<int>(std::min<long>(most_batches, fit)));
-    out.error_reliable = out.batches >= fewest_reliable_batches;
+    // batch_means' own test (a batch >= 5 tau) and enough batches
+    out.error_reliable = out.error_reliable && out.batches >= fewest_reliable_batches;
     return out;
   }
   // too short for two batches of batch_over_tau correlation times

@@ -51,7 +51,8 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches);
 // batches), so error_reliable is set only from `fewest_reliable_batches` on. A
 // window shorter than two such batches has no batch-means error: the error is
 // then sigma sqrt(tau / n) from the measured correlation time, batches = 0,
-// and it is flagged unreliable.
+// and it is flagged unreliable (one sample: error 0, unreliable). A series
+// holding a NaN or infinity gets NaN mean and error.
 SteadyAverage steady_average(const std::vector<double>& series, int most_batches = 10,
                              double batch_over_tau = 5.0, int fewest_reliable_batches = 5);
 

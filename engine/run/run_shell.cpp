@@ -5,10 +5,9 @@
 #include "engine/output/atomic_file.hpp"
 #include "engine/process/stop_signal.hpp"
 
-// The library is built without the application's definition; the project's
-// version is the same string.
+// The project's version, from CMake (engine/CMakeLists.txt).
 #ifndef FLOCSIM_VERSION
-#define FLOCSIM_VERSION "0.1.0"
+#error "FLOCSIM_VERSION must come from the build (project VERSION)"
 #endif
 
 namespace flocsim::run {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "engine/observables/aggregates.hpp"
@@ -176,8 +177,9 @@ TEST(SteadyAverage, BatchesSpanFiveCorrelationTimesAndGiveTheAnalyticError) {
   }
   EXPECT_NEAR(ratio, 1.0, 0.25);
   // 800 samples (42 tau, like a 400 a/U_inf window with a 10 a/U_inf
-  // correlation time sampled every 0.5): batches of >= 5 measured tau leave
-  // room for at most 8; each batch holds n / batches >= 5 tau samples
+  // correlation time sampled every 0.5): each batch holds n / batches >= 5
+  // measured tau samples (the measured tau of so short a series reads 15-20 %
+  // low, so the batches usually number 9-10 rather than 8)
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const auto x = ar1(800, 0.9, seed);
     const SteadyAverage a = steady_average(x);
@@ -209,10 +211,19 @@ TEST(SteadyAverage, AWindowShorterThanTwoBatchesFallsBackToTheCorrelationTime) {
     EXPECT_NEAR(a.error, std::sqrt(var * a.correlation_samples / n), 1e-12) << seed;
   }
   // white noise: tau ~ 1, so the 10 batches of the cap fit and the error is
-  // sigma / sqrt(n) = 0.01 within the 24 % scatter of 10 batches (3 sigma)
-  const SteadyAverage w = steady_average(ar1(10000, 0.0, 4));
-  EXPECT_EQ(w.batches, 10);
-  EXPECT_NEAR(w.error, 0.01, 0.0072);
+  // sigma / sqrt(n) = 0.01: 24 % scatter per series over 10 batches, 7.5 %
+  // averaged over 10 series, so 25 % is over 3 sigma
+  double white = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const SteadyAverage w = steady_average(ar1(10000, 0.0, seed));
+    EXPECT_EQ(w.batches, 10) << seed;
+    white += w.error / 0.01 / 10;
+  }
+  EXPECT_NEAR(white, 1.0, 0.25);
+  // a non-finite sample leaves no average
+  std::vector<double> broken = ar1(100, 0.0, 1);
+  broken[50] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(steady_average(broken).error));
 }
 
 TEST(Stationarity, DetectsTheEndOfAnExponentialRelaxation) {

@@ -67,10 +67,14 @@ TEST(LiquidScenes, CiSizedSuspensionProducesEveryOutput) {
     // batches of at least 5 correlation times, at most 10 (0: window too short)
     const int batches = obs[key]["batches"].get<int>();
     EXPECT_LE(batches, 10) << key;
+    EXPECT_EQ(obs[key]["error_reliable"].get<bool>(), batches >= 5) << key;
+    EXPECT_GT(obs[key]["error"].get<double>(), 0.0) << key;
+    const double samples = obs[key]["samples"].get<double>(),
+                 tau = obs[key]["correlation_samples"].get<double>();
     if (batches > 0) {
-      EXPECT_GE(obs[key]["samples"].get<double>() / batches,
-                5 * obs[key]["correlation_samples"].get<double>())
-          << key;
+      EXPECT_GE(samples / batches, 5 * tau) << key;
+    } else {  // only when two batches of 5 tau do not fit
+      EXPECT_LT(samples, 2 * std::ceil(5 * tau)) << key;
     }
   }
   // the spheres settle (slip along -x relative to the liquid: U > 0) and
