@@ -58,7 +58,9 @@ std::vector<double> slab_solids_fraction(const std::vector<spheres::Vec3>& posit
   return volume;
 }
 
-SteadyAverage batch_means(const std::vector<double>& series, int batches) {
+namespace {
+// Batch means with the series' integrated correlation time already measured.
+SteadyAverage batch_means_with_tau(const std::vector<double>& series, int batches, double tau) {
   SteadyAverage out;
   out.samples = static_cast<long>(series.size());
   if (series.empty()) return out;
@@ -84,9 +86,15 @@ SteadyAverage batch_means(const std::vector<double>& series, int batches) {
   out.mean = all / static_cast<double>(series.size());
   out.error = std::sqrt(var / batches);
   out.batches = batches;
-  out.correlation_samples = integrated_correlation_time(series);
+  out.correlation_samples = tau;
   out.error_reliable = static_cast<double>(per) >= 5.0 * out.correlation_samples;
   return out;
+}
+}  // namespace
+
+SteadyAverage batch_means(const std::vector<double>& series, int batches) {
+  return batch_means_with_tau(series, batches,
+                              series.empty() ? 0.0 : integrated_correlation_time(series));
 }
 
 SteadyAverage steady_average(const std::vector<double>& series, int most_batches,
@@ -104,7 +112,7 @@ SteadyAverage steady_average(const std::vector<double>& series, int most_batches
   const long batch_length = std::max(1L, static_cast<long>(std::ceil(batch_over_tau * tau)));
   const long fit = out.samples / batch_length;
   if (fit >= 2) {
-    out = batch_means(series, static_cast<int>(std::min<long>(most_batches, fit)));
+    out = batch_means_with_tau(series, static_cast<int>(std::min<long>(most_batches, fit)), tau);
     // batch_means' own test (a batch >= 5 tau) and enough batches
     out.error_reliable = out.error_reliable && out.batches >= fewest_reliable_batches;
     return out;
