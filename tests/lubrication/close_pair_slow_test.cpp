@@ -42,6 +42,12 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA8) {
   expect_total_near_brenner(8, 0.03, kFewGaps, 14);
 }
 
+// The one-sweep option at a = 8 (calibrated at 0.01, 0.02 and 0.04 in a 12a
+// box) measured again at 0.03 in a 14a box.
+TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA8) {
+  expect_total_near_brenner(8, 0.03, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+}
+
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA4) {
   expect_total_near_brenner(4, 0.03, kFewGaps, 20, immersed_boundary::kOneSweepScheme, "standard");
 }
