@@ -336,9 +336,10 @@ TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
 // Lubrication is the calibrated close-pair model unless the case names
 // Nguyen-Ladd's: it needs the lattice's measured share at the case's a and IB
 // scheme (engine/calibration/pair_resistance.json), and a case without one is
-// refused before any work, naming both ways out. The presets take the
-// one-sweep option only where its close pairs are calibrated within a factor
-// 2 of the case's viscosity, else the paper's method.
+// refused before any work, naming both ways out. The presets take the paper's
+// method instead of the one-sweep option where the option's close pairs lie
+// more than a factor 2 from the case's viscosity and the paper method's lie
+// nearer; where neither is near, the option runs with a warning.
 TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   using calibration::PairResistanceTable;
   const auto& pairs = PairResistanceTable::shipped();
