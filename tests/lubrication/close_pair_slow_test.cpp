@@ -36,6 +36,17 @@ TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6LowViscosity) {
   expect_total_near_brenner(6, 0.014, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
 }
 
+// a = 6 at nu = 0.0075, between the 0.005 and 0.01 entries: the paper's grid
+// point Re_inf = 48 at a = 6, U_inf = 0.03 (nu = 2 a U_inf / Re_inf), both IB
+// options. Low viscosity: the slowest of these tests.
+TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6Re48) {
+  expect_total_near_brenner(6, 0.0075, kFewGaps, 14);
+}
+
+TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6Re48) {
+  expect_total_near_brenner(6, 0.0075, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+}
+
 // a = 8 (calibrated at 0.01, 0.02 and 0.04 in a 12a box) measured again at
 // 0.03 in a 14a box.
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA8) {
