@@ -38,7 +38,7 @@ TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6LowViscosity) {
 
 // a = 6 at nu = 0.0075, between the 0.005 and 0.01 entries: the paper's grid
 // point Re_inf = 48 at a = 6, U_inf = 0.03 (nu = 2 a U_inf / Re_inf), both IB
-// options. Low viscosity: the slowest of these tests.
+// options (12.5-14 min each on one thread).
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6Re48) {
   expect_total_near_brenner(6, 0.0075, kFewGaps, 14);
 }
