@@ -44,7 +44,8 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6Re48) {
 }
 
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6Re48) {
-  expect_total_near_brenner(6, 0.0075, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+  expect_total_near_brenner(6, 0.0075, kFewGaps, 14, immersed_boundary::kOneSweepScheme,
+                            "standard");
 }
 
 // a = 8 (calibrated at 0.01, 0.02 and 0.04 in a 12a box) measured again at
