@@ -101,7 +101,7 @@ Figures run_case(int n, int reps, int steps, double speed_scale) {
   const lubrication::RadialLubrication calibrated(
       {.viscosity = kNu,
        .lattice_share = calibration::PairResistanceTable::shipped().lattice_share(
-           kA, kNu, immersed_boundary::kPaperScheme)});
+           kA, kNu, coupling::kPaperScheme)});
   // Start-up as in the run protocol (docs/model.md section 3): no well first, then switched on with
   // pairs inside bound.
   for (int k = 0; k < 100; ++k) {

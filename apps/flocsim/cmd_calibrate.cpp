@@ -30,9 +30,12 @@ struct CalibrateOptions {
   std::vector<int> boxes;
   std::vector<double> chis = {0.35, 0.5, 0.7};
   double viscosity = 1.0 / 6.0;
-  double marker_spacing = immersed_boundary::kPaperScheme.marker_spacing;
-  int sweeps = immersed_boundary::kPaperScheme.sweeps;
+  double marker_spacing = coupling::kPaperScheme.marker_spacing;
+  int sweeps = coupling::kPaperScheme.sweeps;
   std::string kernel = "roma3";
+  std::string method = "immersed-boundary";
+  std::string forcing = "direct";
+  std::vector<double> gains;  // control forcing: integral, proportional
   double tolerance = 1e-6;
   std::string table;
   bool close_pairs = false;
@@ -41,8 +44,18 @@ struct CalibrateOptions {
   double pair_box_over_a = 16;
 };
 
-immersed_boundary::Scheme scheme_of(const CalibrateOptions& o) {
-  return {o.marker_spacing, o.sweeps, *immersed_boundary::kernel_from_name(o.kernel)};
+coupling::Scheme scheme_of(const CalibrateOptions& o) {
+  coupling::Scheme s;
+  s.method = *coupling::method_from_name(o.method);
+  s.marker_spacing = o.marker_spacing;
+  s.sweeps = o.sweeps;
+  s.kernel = *coupling::kernel_from_name(o.kernel);
+  s.forcing = *coupling::forcing_from_name(o.forcing);
+  if (s.control()) {
+    s.sweeps = 1;
+    if (o.gains.size() == 2) s.gains = {o.gains[0], o.gains[1]};
+  }
+  return s;
 }
 
 void print_pair_point(const calibration::PairResistancePoint& p) {
@@ -142,7 +155,15 @@ const bool registered = register_command(
        cmd.add_option("--sweeps,--iterations", o->sweeps, "direct-forcing sweeps per step")
            ->check(CLI::Range(1, 20));
        cmd.add_option("--kernel", o->kernel, "interpolation/spreading kernel")
-           ->check(CLI::IsMember(immersed_boundary::kernel_names()));
+           ->check(CLI::IsMember(coupling::kernel_names()));
+       cmd.add_option("--coupling", o->method, "coupling scheme of the spheres and the liquid")
+           ->check(CLI::IsMember(coupling::method_names()));
+       cmd.add_option("--forcing", o->forcing,
+                      "immersed boundary: direct forcing (--sweeps) or control forcing (--gains)")
+           ->check(CLI::IsMember(coupling::forcing_names()));
+       cmd.add_option("--gains", o->gains,
+                      "control forcing: integral and proportional gain (docs/coupling.md)")
+           ->expected(2);
        cmd.add_option("--tolerance", o->tolerance,
                       "steady state: relative change of U per 100 steps")
            ->check(CLI::Range(1e-10, 1e-3));

@@ -11,7 +11,7 @@
 
 #include "engine/calibration/shipped_table.hpp"
 #include "engine/calibration/table_scheme.hpp"
-#include "engine/immersed_boundary/immersed_boundary.hpp"
+#include "engine/coupling_schemes/make_coupling.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/spheres/sphere_set.hpp"
 
@@ -82,9 +82,8 @@ class ArrayFlow {
 
   ArrayDragResult run_to_steady(double input_radius) {
     // The previous sphere's force leaves the lattice with it.
-    if (ib_) ib_->remove(fluid_);
-    ib_ = std::make_unique<immersed_boundary::ImmersedBoundary<double>>(
-        immersed_boundary::ImmersedBoundarySettings{input_radius, settings_.scheme, false});
+    if (coupling_) coupling_->remove(fluid_);
+    coupling_ = coupling::make_coupling<double>(settings_.scheme, input_radius);
     sphere_.radius = input_radius;
     // Body force from the reference drag of a sphere of radius a_g, so that U
     // comes out near the requested superficial velocity.
@@ -104,8 +103,9 @@ class ArrayFlow {
     long step = 0;
     while (step < settings_.max_steps) {
       for (int s = 0; s < kCheck; ++s, ++step) {
-        ib_->apply(fluid_, sphere_);
+        coupling_->apply(fluid_, sphere_);
         fluid_.step();
+        coupling_->after_liquid_step(fluid_, sphere_);
       }
       const double u = fluid_.total_momentum().x / fluid_.total_mass();
       if (!std::isfinite(u)) throw std::runtime_error("simple cubic array: velocity not finite");
@@ -118,7 +118,7 @@ class ArrayFlow {
                                ", L = " + std::to_string(box_) + "): no steady state within " +
                                std::to_string(settings_.max_steps) + " steps");
     r.superficial_velocity = previous;
-    r.ib_force = std::abs(ib_->force()[0].x());
+    r.ib_force = std::abs(coupling_->force()[0].x());
     r.steps = step;
     r.hydrodynamic_radius = hydrodynamic_radius_from_drag(
         body_force * cells, r.superficial_velocity, settings_.viscosity, box_);
@@ -130,7 +130,7 @@ class ArrayFlow {
   ArrayDragSettings settings_;
   lattice::FluidLattice<double> fluid_;
   spheres::SphereSet sphere_;
-  std::unique_ptr<immersed_boundary::ImmersedBoundary<double>> ib_;
+  std::unique_ptr<coupling::SphereCoupling<double>> coupling_;
 };
 
 }  // namespace
@@ -185,7 +185,8 @@ nlohmann::json to_json(const ArrayDragResult& r, double viscosity) {
 void CalibrationTable::add(const CalibrationEntry& entry) {
   std::erase_if(entries_, [&](const CalibrationEntry& e) {
     return std::abs(e.hydrodynamic_radius - entry.hydrodynamic_radius) < 1e-6 &&
-           std::abs(e.viscosity - entry.viscosity) < 1e-9 && e.scheme == entry.scheme;
+           std::abs(e.viscosity - entry.viscosity) < 1e-9 &&
+           e.scheme.same_calibration(entry.scheme);
   });
   entries_.push_back(entry);
   std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) {
@@ -261,20 +262,20 @@ CalibrationTable CalibrationTable::parse(const std::string& json_text, const std
 namespace {
 // An entry for this a made with this immersed-boundary scheme.
 bool same_scheme(const CalibrationEntry& e, double hydrodynamic_radius,
-                 const immersed_boundary::Scheme& scheme) {
-  return std::abs(e.hydrodynamic_radius - hydrodynamic_radius) <= 1e-6 && e.scheme == scheme;
+                 const coupling::Scheme& scheme) {
+  return std::abs(e.hydrodynamic_radius - hydrodynamic_radius) <= 1e-6 &&
+         e.scheme.same_calibration(scheme);
 }
 }  // namespace
 
-bool CalibrationTable::has(double hydrodynamic_radius,
-                           const immersed_boundary::Scheme& scheme) const {
+bool CalibrationTable::has(double hydrodynamic_radius, const coupling::Scheme& scheme) const {
   return std::any_of(entries_.begin(), entries_.end(), [&](const CalibrationEntry& e) {
     return same_scheme(e, hydrodynamic_radius, scheme);
   });
 }
 
 const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, double viscosity,
-                                                 const immersed_boundary::Scheme& scheme) const {
+                                                 const coupling::Scheme& scheme) const {
   const CalibrationEntry* best = nullptr;
   for (const auto& e : entries_) {
     if (!same_scheme(e, hydrodynamic_radius, scheme)) continue;
@@ -300,7 +301,7 @@ const CalibrationEntry& CalibrationTable::lookup(double hydrodynamic_radius, dou
 }
 
 double CalibrationTable::input_radius(double hydrodynamic_radius, double viscosity,
-                                      const immersed_boundary::Scheme& scheme) const {
+                                      const coupling::Scheme& scheme) const {
   const CalibrationEntry& nearest = lookup(hydrodynamic_radius, viscosity, scheme);
   const CalibrationEntry *below = nullptr, *above = nullptr;
   for (const auto& e : entries_) {

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/coupling/scheme.hpp"
 
 namespace flocsim::calibration {
 
@@ -31,7 +31,7 @@ double hasimoto_drag(double chi);
 
 struct ArrayDragSettings {
   double viscosity = 1.0 / 6.0;  // lattice viscosity of the calibration runs
-  immersed_boundary::Scheme scheme;
+  coupling::Scheme scheme;
   double superficial_velocity = 1e-4;  // sets the body force through the reference K; Re << 1
   double tolerance = 1e-6;             // relative change of U per 100 steps at steady state
   long max_steps = 400000;
@@ -63,7 +63,7 @@ struct CalibrationEntry {
   double hydrodynamic_radius = 0;  // a (dx)
   double viscosity = 0;
   double input_radius = 0;  // a_g (dx)
-  immersed_boundary::Scheme scheme;
+  coupling::Scheme scheme;
   std::vector<ArrayDragResult> checks;  // the runs with the final a_g
 };
 
@@ -92,16 +92,16 @@ class CalibrationTable {
   // is nearest to nu. Throws std::out_of_range, naming what exists, when no
   // entry has that a and scheme.
   const CalibrationEntry& lookup(double hydrodynamic_radius, double viscosity,
-                                 const immersed_boundary::Scheme& scheme = {}) const;
+                                 const coupling::Scheme& scheme = {}) const;
   // Whether any entry has this a and scheme.
-  bool has(double hydrodynamic_radius, const immersed_boundary::Scheme& scheme) const;
+  bool has(double hydrodynamic_radius, const coupling::Scheme& scheme) const;
   // The input radius for a at nu: between the two entries (same a and
   // scheme) whose viscosities bracket nu, a_g interpolated linearly in
   // log(nu) (the offset a - a_g varies smoothly with log nu: 0.431 to 0.388 dx
   // from nu = 0.005 to 1/6 at a = 6); outside the calibrated viscosities, the
   // nearest entry's a_g (no extrapolation). Throws like lookup().
   double input_radius(double hydrodynamic_radius, double viscosity,
-                      const immersed_boundary::Scheme& scheme = {}) const;
+                      const coupling::Scheme& scheme = {}) const;
   std::string note;  // how the table was made
 
  private:

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -11,7 +12,7 @@
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/calibration/shipped_pair_table.hpp"
 #include "engine/calibration/table_scheme.hpp"
-#include "engine/immersed_boundary/immersed_boundary.hpp"
+#include "engine/coupling_schemes/make_coupling.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lubrication/two_sphere_resistance.hpp"
 
@@ -31,8 +32,8 @@ class HeldPair {
         V_(0.5 * set.reynolds * set.viscosity / a),
         set_(set),
         fluid_({box_, box_ / 2, box_ / 2}, {set.viscosity, 0.25}),
-        ib_({CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme), set.scheme,
-             false}) {
+        coupling_(coupling::make_coupling<double>(
+            set.scheme, CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme))) {
     fluid_.initialise_equilibrium([](int, int, int) { return lattice::Macroscopic{}; });
     pair_.radius = a;
     pair_.resize(2);
@@ -51,11 +52,12 @@ class HeldPair {
     double last = 0;
     int quiet_checks = 0;  // consecutive checks below the tolerance
     for (long step = 1; step <= set_.max_steps; ++step) {
-      ib_.apply(fluid_, pair_);
+      coupling_->apply(fluid_, pair_);
       fluid_.step();
+      coupling_->after_liquid_step(fluid_, pair_);
       if (step % 200 != 0) continue;
       // the force on sphere 0 opposes its motion, which is +x when approaching
-      const double lambda = -towards_ * ib_.force()[0].x() / (6 * M_PI * nu_ * a_ * V_);
+      const double lambda = -towards_ * coupling_->force()[0].x() / (6 * M_PI * nu_ * a_ * V_);
       if (!std::isfinite(lambda))
         throw std::runtime_error("pair resistance: the measurement blew up at gap " +
                                  std::to_string(gap_over_a) + " a");
@@ -78,7 +80,7 @@ class HeldPair {
   double towards_, V_;
   PairResistanceSettings set_;
   lattice::FluidLattice<double> fluid_;
-  immersed_boundary::ImmersedBoundary<double> ib_;
+  std::unique_ptr<coupling::SphereCoupling<double>> coupling_;
   spheres::SphereSet pair_;
 };
 
@@ -200,8 +202,9 @@ PairResistanceTable PairResistanceTable::parse(const std::string& json_text,
 }
 
 namespace {
-bool same_scheme(const PairResistanceEntry& e, double a, const immersed_boundary::Scheme& scheme) {
-  return !e.separating && std::abs(e.hydrodynamic_radius - a) <= 1e-6 && e.scheme == scheme;
+bool same_scheme(const PairResistanceEntry& e, double a, const coupling::Scheme& scheme) {
+  return !e.separating && std::abs(e.hydrodynamic_radius - a) <= 1e-6 &&
+         e.scheme.same_calibration(scheme);
 }
 
 // The approaching entries of this a and scheme nearest nu from below and from
@@ -211,7 +214,7 @@ struct Bracket {
   const PairResistanceEntry* above = nullptr;
 };
 Bracket bracket(const std::vector<PairResistanceEntry>& entries, double a, double nu,
-                const immersed_boundary::Scheme& scheme) {
+                const coupling::Scheme& scheme) {
   Bracket b;
   for (const auto& e : entries) {
     if (!same_scheme(e, a, scheme)) continue;
@@ -226,18 +229,19 @@ void PairResistanceTable::add(const PairResistanceEntry& entry) {
   std::erase_if(entries_, [&](const PairResistanceEntry& e) {
     return e.separating == entry.separating &&
            std::abs(e.hydrodynamic_radius - entry.hydrodynamic_radius) <= 1e-6 &&
-           std::abs(e.viscosity - entry.viscosity) <= 1e-12 && e.scheme == entry.scheme;
+           std::abs(e.viscosity - entry.viscosity) <= 1e-12 &&
+           e.scheme.same_calibration(entry.scheme);
   });
   entries_.push_back(entry);
 }
 
-bool PairResistanceTable::has(double a, const immersed_boundary::Scheme& scheme) const {
+bool PairResistanceTable::has(double a, const coupling::Scheme& scheme) const {
   return std::any_of(entries_.begin(), entries_.end(),
                      [&](const auto& e) { return same_scheme(e, a, scheme); });
 }
 
 std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
-    double a, double nu, const immersed_boundary::Scheme& scheme) const {
+    double a, double nu, const coupling::Scheme& scheme) const {
   auto [below, above] = bracket(entries_, a, nu, scheme);
   if (!below && !above) {
     std::ostringstream msg;
@@ -269,20 +273,19 @@ std::vector<std::pair<double, double>> PairResistanceTable::lattice_share(
 }
 
 double PairResistanceTable::viscosity_gap(double a, double nu,
-                                          const immersed_boundary::Scheme& scheme) const {
+                                          const coupling::Scheme& scheme) const {
   const auto [below, above] = bracket(entries_, a, nu, scheme);
   if (!below && !above) return std::numeric_limits<double>::infinity();
   if (below && above) return 1.0;
   return below ? nu / below->viscosity : above->viscosity / nu;
 }
 
-std::string close_pair_calibrate_command(double a, double nu,
-                                         const immersed_boundary::Scheme& scheme) {
+std::string close_pair_calibrate_command(double a, double nu, const coupling::Scheme& scheme) {
   std::ostringstream cmd;
   cmd << "flocsim calibrate --close-pairs --radius " << a << " --viscosity " << nu;
   if (a >= 6) cmd << " --pair-box 12";
   cmd << " --marker-spacing " << scheme.marker_spacing << " --sweeps " << scheme.sweeps
-      << " --kernel " << immersed_boundary::kernel_name(scheme.kernel)
+      << " --kernel " << coupling::kernel_name(scheme.kernel)
       << " --table engine/calibration/pair_resistance.json";
   return cmd.str();
 }

@@ -18,13 +18,13 @@
 #include <utility>
 #include <vector>
 
-#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/coupling/scheme.hpp"
 
 namespace flocsim::calibration {
 
 struct PairResistanceSettings {
   double viscosity = 1.0 / 6.0;
-  immersed_boundary::Scheme scheme;
+  coupling::Scheme scheme;
   double box_over_a = 16;   // box 16a x 8a x 8a (rounded to whole cells)
   double reynolds = 0.01;   // 2 a V / nu: creeping flow
   double tolerance = 2e-6;  // steady: relative change of lambda per 200 steps
@@ -50,7 +50,7 @@ std::vector<double> default_pair_gaps();
 struct PairResistanceEntry {
   double hydrodynamic_radius = 0;
   double viscosity = 0;
-  immersed_boundary::Scheme scheme;
+  coupling::Scheme scheme;
   int box = 0;  // length along the line of centres (dx); the cross-section is half
   bool separating = false;
   double box_offset = 0;                    // lambda_measured - lambda_exact at the largest gap
@@ -71,8 +71,7 @@ PairResistanceEntry calibrate_pair_resistance(
 // radius a, viscosity nu and IB scheme lacks (a >= 6 in a 12a box, as the
 // shipped a = 6 entries: a 16a box costs 2.4x more for the same lambda_IB
 // once the box's offset is removed).
-std::string close_pair_calibrate_command(double a, double nu,
-                                         const immersed_boundary::Scheme& scheme);
+std::string close_pair_calibrate_command(double a, double nu, const coupling::Scheme& scheme);
 
 class PairResistanceTable {
  public:
@@ -85,19 +84,18 @@ class PairResistanceTable {
   void add(const PairResistanceEntry& entry);
   const std::vector<PairResistanceEntry>& entries() const { return entries_; }
   // Whether an approaching entry exists for this a and scheme.
-  bool has(double hydrodynamic_radius, const immersed_boundary::Scheme& scheme = {}) const;
+  bool has(double hydrodynamic_radius, const coupling::Scheme& scheme = {}) const;
   // lambda_IB at the gaps of the calibration, (s/a, lambda_IB) in increasing
   // s/a, for a at nu: between the two approaching entries whose viscosities
   // bracket nu, linear in log(nu) at every gap; outside the calibrated
   // viscosities the nearest entry (no extrapolation). Throws std::out_of_range
   // naming what exists when no entry has this a and scheme.
-  std::vector<std::pair<double, double>> lattice_share(
-      double hydrodynamic_radius, double viscosity,
-      const immersed_boundary::Scheme& scheme = {}) const;
+  std::vector<std::pair<double, double>> lattice_share(double hydrodynamic_radius, double viscosity,
+                                                       const coupling::Scheme& scheme = {}) const;
   // How far viscosity lies outside the calibrated ones for this a and scheme,
   // as a factor >= 1 (1 when two entries bracket it); infinity without entry.
   double viscosity_gap(double hydrodynamic_radius, double viscosity,
-                       const immersed_boundary::Scheme& scheme = {}) const;
+                       const coupling::Scheme& scheme = {}) const;
   std::string note;
 
  private:

@@ -34,11 +34,11 @@ constexpr double kNearViscosityFactor = 2.0 * (1 + 1e-9);
 // where it is validated, phi <= 0.2; paper keeps the paper's method.
 struct Preset {
   double radius_cells, length_over_a, stage1_min, stage1_max, stage2_settle, statistics;
-  immersed_boundary::Scheme ib_scheme;
+  coupling::Scheme coupling;
 };
 Preset preset(const std::string& fidelity) {
-  using immersed_boundary::kOneSweepScheme;
-  using immersed_boundary::kPaperScheme;
+  using coupling::kOneSweepScheme;
+  using coupling::kPaperScheme;
   if (fidelity == "draft") return {4, 16, 5, 20, 10, 20, kOneSweepScheme};
   if (fidelity == "standard") return {6, 32, 20, 100, 50, 100, kOneSweepScheme};
   return {6, 48, 30, 150, 100, 300, kPaperScheme};  // paper
@@ -46,26 +46,24 @@ Preset preset(const std::string& fidelity) {
 
 // numerics.immersed_boundary: {"marker_spacing", "sweeps", "kernel"}, each
 // defaulting to the preset's value.
-immersed_boundary::Scheme read_ib_scheme(InputReader& numerics,
-                                         const immersed_boundary::Scheme& preset_scheme) {
-  immersed_boundary::Scheme scheme = preset_scheme;
+coupling::Scheme read_ib_scheme(InputReader& numerics, const coupling::Scheme& preset_scheme) {
+  coupling::Scheme scheme = preset_scheme;
   if (!numerics.has("immersed_boundary")) return scheme;
   InputReader ib = numerics.object("immersed_boundary");
   scheme.marker_spacing =
       ib.number("marker_spacing", {.above = 0.2, .at_most = 1.5}, preset_scheme.marker_spacing);
   scheme.sweeps =
       static_cast<int>(ib.integer("sweeps", {.at_least = 1, .at_most = 20}, preset_scheme.sweeps));
-  scheme.kernel = *immersed_boundary::kernel_from_name(
-      ib.choice("kernel", immersed_boundary::kernel_names(),
-                immersed_boundary::kernel_name(preset_scheme.kernel)));
+  scheme.kernel = *coupling::kernel_from_name(
+      ib.choice("kernel", coupling::kernel_names(), coupling::kernel_name(preset_scheme.kernel)));
   ib.finish();
   return scheme;
 }
 
 // "{marker_spacing 1, sweeps 1, kernel roma3}"
-std::string scheme_fields(const immersed_boundary::Scheme& s) {
+std::string scheme_fields(const coupling::Scheme& s) {
   return "{marker_spacing " + format_value(s.marker_spacing) + ", sweeps " +
-         std::to_string(s.sweeps) + ", kernel " + immersed_boundary::kernel_name(s.kernel) + "}";
+         std::to_string(s.sweeps) + ", kernel " + coupling::kernel_name(s.kernel) + "}";
 }
 
 // Sphere centres of a snapshot written by a run (spheres/step_N.h5), checked
@@ -128,7 +126,7 @@ namespace {
 // moving spheres, more than one forcing sweep, a < 6 dx, nu below its floor.
 bool multi_sweep_oscillates(const SuspensionCase& c) {
   return modules_of(c.scene).liquid && modules_of(c.scene).spheres_move &&
-         c.numerics.ib_scheme.sweeps > 1 && c.numerics.radius_cells < 6 &&
+         c.numerics.coupling.sweeps > 1 && c.numerics.radius_cells < 6 &&
          c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
 }
 // The U_inf that puts this case's viscosity on that floor.
@@ -231,27 +229,27 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // the paper method's is nearer (where neither is, the faster one runs,
     // with the same warning).
     const auto& radii = calibration::CalibrationTable::shipped();
-    auto calibrated_near = [&](const immersed_boundary::Scheme& scheme) {
+    auto calibrated_near = [&](const coupling::Scheme& scheme) {
       return radii.has(a, scheme) &&
              std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
                                c.numerics.viscosity)) <= std::log(kNearViscosityFactor);
     };
-    auto pair_gap = [&](const immersed_boundary::Scheme& scheme) {
+    auto pair_gap = [&](const coupling::Scheme& scheme) {
       return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
                                                                        scheme);
     };
     auto choose_scheme = [&] {
-      immersed_boundary::Scheme preset_scheme = p.ib_scheme;
+      coupling::Scheme preset_scheme = p.coupling;
       if (!c.positions_from.empty() ||
-          c.physics.phi > immersed_boundary::largest_validated_phi(preset_scheme) ||
+          c.physics.phi > coupling::largest_validated_phi(preset_scheme) ||
           !calibrated_near(preset_scheme) ||
           (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
            pair_gap(preset_scheme) > kNearViscosityFactor &&
-           pair_gap(immersed_boundary::kPaperScheme) < pair_gap(preset_scheme)))
-        preset_scheme = immersed_boundary::kPaperScheme;
+           pair_gap(coupling::kPaperScheme) < pair_gap(preset_scheme)))
+        preset_scheme = coupling::kPaperScheme;
       return read_ib_scheme(num, preset_scheme);
     };
-    c.numerics.ib_scheme = choose_scheme();
+    c.numerics.coupling = choose_scheme();
     // By default also stay clear of the multi-sweep coupling's oscillation
     // (below): raise U_inf until nu reaches its floor, where the Mach limit
     // allows, and choose again at that viscosity.
@@ -260,7 +258,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       if (u <= kMaxSettlingVelocity) {
         c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
         c.derived.settling_velocity = u;
-        c.numerics.ib_scheme = choose_scheme();
+        c.numerics.coupling = choose_scheme();
       }
     }
   }
@@ -321,12 +319,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     bool offered = false;
     std::string names;
     for (const auto& e : table.entries()) {
-      offered = offered || e.scheme == c.numerics.ib_scheme;
+      offered = offered || e.scheme == c.numerics.coupling;
       const std::string n = scheme_fields(e.scheme);
       if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
     }
     if (!offered)
-      throw InputError("numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) +
+      throw InputError("numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
                        ": not an offered option (no calibration of it is shipped at any a); "
                        "offered: " +
                        names + " (docs/accuracy-cost.md)");
@@ -335,21 +333,21 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one
     const auto& table = calibration::CalibrationTable::shipped();
-    if (table.has(a, immersed_boundary::kPaperScheme) && !table.has(a, c.numerics.ib_scheme))
+    if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
       throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) +
+          "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
           ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
-          c.numerics.ib_scheme.describe() + "); calibrate it with `flocsim calibrate --radius " +
+          c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
           format_value(a) + " --viscosity NU --marker-spacing " +
-          format_value(c.numerics.ib_scheme.marker_spacing) + " --sweeps " +
-          std::to_string(c.numerics.ib_scheme.sweeps) + " --kernel " +
-          immersed_boundary::kernel_name(c.numerics.ib_scheme.kernel) +
+          format_value(c.numerics.coupling.marker_spacing) + " --sweeps " +
+          std::to_string(c.numerics.coupling.sweeps) + " --kernel " +
+          coupling::kernel_name(c.numerics.coupling.kernel) +
           " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
           "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
     try {
-      c.numerics.input_radius = table.input_radius(a, c.numerics.viscosity, c.numerics.ib_scheme);
+      c.numerics.input_radius = table.input_radius(a, c.numerics.viscosity, c.numerics.coupling);
       c.numerics.calibration_viscosity =
-          table.lookup(a, c.numerics.viscosity, c.numerics.ib_scheme).viscosity;
+          table.lookup(a, c.numerics.viscosity, c.numerics.coupling).viscosity;
     } catch (const std::out_of_range& e) {
       throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
                        " Or give numerics.input_radius (the marker radius a_g) yourself.");
@@ -375,8 +373,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
                          format_value(kSmallestMultiSweepViscosityBelowA6));
     else if (u_needed <= kMaxSettlingVelocity)
       remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
-    if (c.physics.phi <=
-        immersed_boundary::largest_validated_phi(immersed_boundary::kOneSweepScheme))
+    if (c.physics.phi <= coupling::largest_validated_phi(coupling::kOneSweepScheme))
       remedies.push_back(
           "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
           "\"sweeps\": 1})");
@@ -385,7 +382,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     for (std::size_t k = 0; k < remedies.size(); ++k)
       ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];
     throw InputError("numerics: viscosity = " + format_value(c.numerics.viscosity) + " with " +
-                     std::to_string(c.numerics.ib_scheme.sweeps) +
+                     std::to_string(c.numerics.coupling.sweeps) +
                      " immersed-boundary sweeps at a_over_dx = " + format_value(a) +
                      ": the coupling of moving spheres is measured to oscillate there below "
                      "viscosity " +
@@ -397,18 +394,18 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     const auto& pairs = calibration::PairResistanceTable::shipped();
     try {
       c.numerics.lubrication_lattice_share =
-          pairs.lattice_share(a, c.numerics.viscosity, c.numerics.ib_scheme);
+          pairs.lattice_share(a, c.numerics.viscosity, c.numerics.coupling);
     } catch (const std::out_of_range& e) {
       throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
                        format_value(a) + ": " + e.what());
     }
-    const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.ib_scheme);
+    const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.coupling);
     if (gap > kNearViscosityFactor)
       c.warnings.push_back(
           "the close-pair calibration nearest to viscosity = " +
           format_value(c.numerics.viscosity) + " at a_over_dx = " + format_value(a) +
           " lies a factor " + format_value(gap) + " away; `" +
-          calibration::close_pair_calibrate_command(a, c.numerics.viscosity, c.numerics.ib_scheme) +
+          calibration::close_pair_calibrate_command(a, c.numerics.viscosity, c.numerics.coupling) +
           "` and a rebuild make one");
     if (c.numerics.input_radius_given)
       c.warnings.push_back(
@@ -470,12 +467,12 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   // 0.2015: rounding, not a denser suspension), for a snapshot's N too.
   const double phi_asked = (c.derived.sphere_count - 0.5) * sphere_volume / volume;
   if (modules_of(c.scene).liquid &&
-      phi_asked > immersed_boundary::largest_validated_phi(c.numerics.ib_scheme))
+      phi_asked > coupling::largest_validated_phi(c.numerics.coupling))
     throw InputError(
-        "numerics.immersed_boundary = " + scheme_fields(c.numerics.ib_scheme) + " with phi = " +
+        "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) + " with phi = " +
         format_value(c.positions_from.empty() ? c.physics.phi : c.derived.phi_realised) +
         ": this option is validated only up to phi = " +
-        format_value(immersed_boundary::largest_validated_phi(c.numerics.ib_scheme)) +
+        format_value(coupling::largest_validated_phi(c.numerics.coupling)) +
         " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
         "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
         "(docs/accuracy-cost.md)");
@@ -532,7 +529,7 @@ nlohmann::json SuspensionCase::to_json() const {
                    {"viscosity", numerics.viscosity},
                    {"trt_magic", numerics.trt_magic}};
   if (modules_of(scene).liquid)
-    j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.ib_scheme);
+    j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.coupling);
   if (numerics.input_radius_given) j["numerics"]["input_radius"] = numerics.input_radius;
   // written only when not the default, so that every case that predates the
   // option keeps its identity
@@ -575,10 +572,10 @@ nlohmann::json SuspensionCase::derived_json() const {
           {"input_radius_from", input_radius_from}};
 }
 
-nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme) {
+nlohmann::json immersed_boundary_json(const coupling::Scheme& scheme) {
   return {{"marker_spacing", scheme.marker_spacing},
           {"sweeps", scheme.sweeps},
-          {"kernel", immersed_boundary::kernel_name(scheme.kernel)}};
+          {"kernel", coupling::kernel_name(scheme.kernel)}};
 }
 
 nlohmann::json with_older_versions_models(nlohmann::json c) {
@@ -593,7 +590,7 @@ nlohmann::json with_older_versions_models(nlohmann::json c) {
     }
   if (immersed && c.contains("numerics") && c["numerics"].is_object() &&
       !c["numerics"].contains("immersed_boundary"))
-    c["numerics"]["immersed_boundary"] = immersed_boundary_json(immersed_boundary::kPaperScheme);
+    c["numerics"]["immersed_boundary"] = immersed_boundary_json(coupling::kPaperScheme);
   if (!lubricated) {
     c.erase("lubrication_model");
     c.erase("lubrication_integration");

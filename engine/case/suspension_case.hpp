@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "engine/case/scene.hpp"
-#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/coupling/scheme.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 
 namespace flocsim::cases {
@@ -85,7 +85,7 @@ struct Numerics {
   std::string inside_liquid = "measured";
   // numerics.immersed_boundary: marker spacing, forcing sweeps, kernel; the
   // preset's default, and only schemes the shipped calibration holds at this a
-  immersed_boundary::Scheme ib_scheme;
+  coupling::Scheme coupling;
   // Marker radius a_g of the immersed boundary, which gives hydrodynamic
   // radius a: numerics.input_radius, or looked up in the shipped calibration
   // table (engine/calibration), interpolated in log(nu) between the calibrated
@@ -155,7 +155,7 @@ struct SuspensionCase {
 SuspensionCase parse_suspension_case(const nlohmann::json& document);
 
 // numerics.immersed_boundary as a case file writes it: {marker_spacing, sweeps, kernel}.
-nlohmann::json immersed_boundary_json(const immersed_boundary::Scheme& scheme);
+nlohmann::json immersed_boundary_json(const coupling::Scheme& scheme);
 
 // A resolved case (result.json's or a checkpoint's "case") as the current
 // version writes it: fields that older versions did not write had one value

@@ -5,9 +5,12 @@
 // engine/lattice/forced_liquid.hpp: rows of the velocity without that force,
 // and a view of the force field; nothing else of the lattice).
 //
-// Options (scheme.hpp): the marker spacing, the number of forcing sweeps and
-// the kernel (Roma's 3-point or the 2-point linear hat). The paper's method is
-// 0.7 dx, two sweeps, Roma.
+// Options (engine/coupling/scheme.hpp): the marker spacing, the kernel (Roma's
+// 3-point or the 2-point linear hat) and the forcing: direct (below, with the
+// number of sweeps) or control (control_forcing.hpp: the marker force carried
+// from step to step, corrected by the slip the last step left: one
+// interpolation per step, of u* plus the sphere's force of the last step).
+// The paper's markers are 0.7 dx apart, with Roma's kernel.
 //
 // Each sphere carries n markers on the sphere of *input* radius a_g (the
 // geometric radius where the no-slip condition is imposed; the calibrated
@@ -52,16 +55,20 @@
 // take whole blocks of one colour at a time and write the force field without
 // atomics.
 //
-// The per-marker physics (kernel weights, the forcing increment, the surface
-// velocity, the inside weight) are plain functions in kernel.hpp and
-// direct_forcing.hpp; immersed_boundary.cpp holds only the scheduling around
-// them (cell boxes, colours, chunk masks, prefetching, vector layout).
+// The per-marker physics (kernel weights, the forcing increments, the surface
+// velocity, the inside weight) are plain functions in kernel.hpp,
+// direct_forcing.hpp and control_forcing.hpp; marker_stencil.hpp vectorises
+// interpolation and spreading; immersed_boundary.cpp holds the steps of one
+// apply() and their scheduling (cell boxes and colours from
+// engine/coupling/sphere_cells.hpp, chunk masks, prefetching).
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/coupling/scheme.hpp"
+#include "engine/coupling/sphere_cells.hpp"
+#include "engine/coupling/sphere_coupling.hpp"
 #include "engine/lattice/forced_liquid.hpp"
 #include "engine/spheres/sphere_set.hpp"
 
@@ -71,21 +78,20 @@ using spheres::Vec3;
 
 struct ImmersedBoundarySettings {
   double input_radius = 5.6;  // a_g: markers sit on this sphere (lattice units)
-  Scheme scheme;              // marker spacing, forcing sweeps, kernel
+  coupling::Scheme scheme;    // marker spacing, forcing (sweeps or gains), kernel
   bool measure_slip = false;  // one more interpolation per step, for diagnostics
 };
 
 template <class Real>
-class ImmersedBoundary {
+class ImmersedBoundary final : public coupling::SphereCoupling<Real> {
  public:
   explicit ImmersedBoundary(ImmersedBoundarySettings settings);
-  ~ImmersedBoundary();
-  ImmersedBoundary(const ImmersedBoundary&) = delete;
-  ImmersedBoundary& operator=(const ImmersedBoundary&) = delete;
+  ~ImmersedBoundary() override;
 
   const ImmersedBoundarySettings& settings() const { return settings_; }
   int markers_per_sphere() const { return static_cast<int>(directions_.size()); }
   double marker_volume() const { return marker_volume_; }
+  std::string_view stage_name() const override { return "immersed_boundary"; }
 
   // Sets the immersed-boundary part of the fluid's force field (enabling the
   // field on first use) for the spheres at their current positions and
@@ -93,27 +99,14 @@ class ImmersedBoundary {
   // Call once per time step, right before fluid.step(). The fluid extent must
   // equal the box length. Spheres must not move between apply() and the
   // fluid step that uses its force.
-  void apply(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& spheres);
+  void apply(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& spheres) override;
 
   // Removes every force this object has put into the field.
-  void remove(lattice::ForcedLiquid<Real>& liquid);
+  void remove(lattice::ForcedLiquid<Real>& liquid) override;
 
-  // Hydrodynamic force and torque (about the centre) on each sphere from the
-  // last apply(): minus the sum of the marker forces and of their moments.
-  const std::vector<Vec3>& force() const { return force_; }
-  const std::vector<Vec3>& torque() const { return torque_; }
-  // Change of the momentum and angular momentum (about the centre) of the
-  // liquid inside each sphere between the previous apply() and the last one
-  // (zero at the first call, or for a sphere whose count changed).
-  const std::vector<Vec3>& internal_momentum_change() const { return internal_momentum_change_; }
-  const std::vector<Vec3>& internal_angular_momentum_change() const {
-    return internal_angular_change_;
-  }
-  // The inside momenta measured by the last apply(); with the setter, a
-  // checkpoint restores them so that a resumed run continues identically.
-  const std::vector<Vec3>& internal_momentum() const { return internal_momentum_; }
-  const std::vector<Vec3>& internal_angular_momentum() const { return internal_angular_; }
-  void set_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular_momentum);
+  // Control forcing: every marker's force density and last slip.
+  std::vector<coupling::NamedArray> memory() const override;
+  void restore_memory(const std::vector<coupling::NamedArray>& memory) override;
 
   // With measure_slip: root-mean-square and maximum over all markers of
   // |u(X_m) - U_surface| after the last sweep of the last apply().
@@ -122,8 +115,16 @@ class ImmersedBoundary {
 
  private:
   struct Workspace;
-  template <int W>  // kernel width
+  template <int W>
+  struct SphereWork;  // the steps of one apply() for one sphere (immersed_boundary.cpp)
+  template <int W>    // kernel width
   void apply_with_kernel(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& spheres);
+  // Cell boxes of the spheres (origins_, rows_) and the chunks they read (need_).
+  void locate(const spheres::SphereSet& spheres, const lattice::Extent& e, double half_width);
+  // One pass over the lattice rows: u* on the chunks the spheres read, and
+  // the last step's force cleared.
+  void read_liquid_velocity(lattice::ForcedLiquid<Real>& liquid,
+                            const lattice::ForceFieldView<Real>& field, bool clear_in_pass);
   void zero_boxes(const lattice::ForceFieldView<Real>& field);
 
   ImmersedBoundarySettings settings_;
@@ -132,9 +133,6 @@ class ImmersedBoundary {
   double marker_volume_ = 0;
   int box_ = 0;  // edge of the cell box around a sphere
 
-  std::vector<Vec3> force_, torque_;
-  std::vector<Vec3> internal_momentum_, internal_angular_;
-  std::vector<Vec3> internal_momentum_change_, internal_angular_change_;
   std::vector<std::array<int, 3>> origins_;  // lowest corner of each sphere's cell box (unwrapped)
   std::vector<std::array<int, 3>> written_;  // boxes holding force from the last apply()
   // Per sphere and box row (j + box k): first and last box cell of the row that
@@ -143,11 +141,13 @@ class ImmersedBoundary {
   std::vector<std::int16_t> rows_, written_rows_;
   // u* = (rho, u without the immersed-boundary force) of the cells the
   // spheres need, four numbers per cell in lattice order, filled by one pass
-  // over the lattice rows per apply(). The rows are cut in 16-cell chunks, one
-  // bit each: need_ marks the chunks the spheres read (all zero between calls),
-  // held_ the chunks holding force from the last apply() (that pass zeroes them).
-  std::vector<Real> ustar_;
-  std::vector<std::uint64_t> need_, held_;
+  // over the lattice rows per apply(). need_ marks the chunks the spheres read (all zero between
+  // calls), held_ the chunks holding force from the last apply() (that pass
+  // zeroes them).
+  std::vector<Real> velocity_;
+  coupling::ChunkMask need_, held_;
+  // Control forcing: per sphere and marker, (0, F_m) and (0, e_previous).
+  std::vector<Real> marker_force_, marker_slip_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
   double rms_slip_ = 0, max_slip_ = 0;
 };

@@ -8,15 +8,8 @@
 #include <stdexcept>
 #include <string>
 
-// The collision must be inlined into the vectorised row loop; GCC and Clang
-// need telling, other compilers get plain inline.
-#if defined(__GNUC__)
-#define FLOCSIM_ALWAYS_INLINE inline __attribute__((always_inline))
-#define FLOCSIM_LAMBDA_ALWAYS_INLINE __attribute__((always_inline))
-#else
-#define FLOCSIM_ALWAYS_INLINE inline
-#define FLOCSIM_LAMBDA_ALWAYS_INLINE
-#endif
+#include "engine/lattice/partially_saturated_collision.hpp"
+#include "engine/lattice/trt_collision.hpp"
 
 namespace flocsim::lattice {
 
@@ -32,57 +25,6 @@ constexpr std::size_t kStrideSkewBytes = 192;
 int wrap(int i, int n) {
   i %= n;
   return i < 0 ? i + n : i;
-}
-
-// Collision parameters in the kernel's precision.
-template <class Real>
-struct CollisionConstants {
-  Real omega_plus, omega_minus;
-  Real force_plus, force_minus;  // 1 - omega/2 of the symmetric / antisymmetric parts
-};
-
-// TRT collision with Guo forcing, on the deviations f_i - w_i of one cell, in
-// place. F is the force density acting on the cell.
-template <class Real>
-FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[kQ], Real Fx, Real Fy, Real Fz,
-                                   const CollisionConstants<Real>& k) {
-  Real drho = 0;
-#pragma GCC unroll 19
-  for (int i = 0; i < kQ; ++i) drho += f[i];
-  const Real rho = Real(1) + drho;
-  const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
-  const Real jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
-  const Real jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
-  const Real inv_rho = Real(1) / rho;
-  const Real ux = (jx + Real(0.5) * Fx) * inv_rho;
-  const Real uy = (jy + Real(0.5) * Fy) * inv_rho;
-  const Real uz = (jz + Real(0.5) * Fz) * inv_rho;
-  const Real usq15 = Real(1.5) * (ux * ux + uy * uy + uz * uz);
-  const Real uF3 = Real(3) * (ux * Fx + uy * Fy + uz * Fz);
-
-  // Rest population: symmetric only.
-  {
-    const Real w0 = Real(kWeightRest);
-    const Real eq = w0 * (drho - rho * usq15);
-    f[0] += -k.omega_plus * (f[0] - eq) - k.force_plus * w0 * uF3;
-  }
-  // Moving populations, one opposite pair (i, i+1) at a time; c = c_i.
-#pragma GCC unroll 9
-  for (int i = 1; i < kQ; i += 2) {
-    const Real wi = Real(w[i]);
-    const Real cu = Real(cx[i]) * ux + Real(cy[i]) * uy + Real(cz[i]) * uz;
-    const Real cF = Real(cx[i]) * Fx + Real(cy[i]) * Fy + Real(cz[i]) * Fz;
-    const Real eq_plus = wi * (drho + rho * (Real(4.5) * cu * cu - usq15));
-    const Real eq_minus = wi * rho * Real(3) * cu;
-    const Real force_plus = wi * (Real(9) * cu * cF - uF3);
-    const Real force_minus = wi * Real(3) * cF;
-    const Real f_plus = Real(0.5) * (f[i] + f[i + 1]);
-    const Real f_minus = Real(0.5) * (f[i] - f[i + 1]);
-    const Real d_plus = -k.omega_plus * (f_plus - eq_plus) + k.force_plus * force_plus;
-    const Real d_minus = -k.omega_minus * (f_minus - eq_minus) + k.force_minus * force_minus;
-    f[i] += d_plus + d_minus;
-    f[i + 1] += d_plus - d_minus;
-  }
 }
 
 // Pointers p[i] with p[i][x] = population i (deviation) of cell (x, y, z) at
@@ -181,6 +123,69 @@ void FluidLattice<Real>::enable_force_field() {
   const long n = static_cast<long>(cells);
 #pragma omp parallel for schedule(static)
   for (long c = 0; c < n; ++c) f[0][c] = f[1][c] = f[2][c] = Real(0);
+}
+
+template <class Real>
+void FluidLattice<Real>::enable_solid_coverage() {
+  if (has_solid_coverage()) return;
+  // One buffer for the eight per-cell arrays, their starts skewed within a
+  // page (96 + 192 k bytes, between the populations' 192 k) so that the same
+  // cell of each array falls in a different cache set.
+  const std::size_t page_elements = kPageBytes / sizeof(Real);
+  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
+  coverage_stride_ = static_cast<long>((cells + page_elements - 1) / page_elements * page_elements +
+                                       kStrideSkewBytes / sizeof(Real));
+  const long skew = static_cast<long>(kStrideSkewBytes / 2 / sizeof(Real));
+  coverage_ = allocate(static_cast<std::size_t>(skew + kCoverageArrays * coverage_stride_));
+  Real* p = coverage_.get();
+  const long n = skew + kCoverageArrays * coverage_stride_;
+#pragma omp parallel for schedule(static)
+  for (long c = 0; c < n; ++c) p[c] = Real(0);
+  chunk_words_ =
+      ((extent_.nx + SolidCoverageView<Real>::kChunk - 1) / SolidCoverageView<Real>::kChunk + 63) /
+      64;
+  covered_chunks_.assign(static_cast<std::size_t>(extent_.rows()) * chunk_words_, 0);
+}
+
+template <class Real>
+SolidCoverageView<Real> FluidLattice<Real>::coverage_view() const {
+  SolidCoverageView<Real> v;
+  v.extent = extent_;
+  Real* base = coverage_.get() + kStrideSkewBytes / 2 / sizeof(Real);
+  Real* array[kCoverageArrays];
+  for (int k = 0; k < kCoverageArrays; ++k) array[k] = base + k * coverage_stride_;
+  v.coverage = array[0];
+  v.density = array[4];
+  for (int d = 0; d < 3; ++d) {
+    v.solid_velocity[d] = array[1 + d];
+    v.momentum[d] = array[5 + d];
+  }
+  v.chunks = const_cast<std::uint64_t*>(covered_chunks_.data());
+  v.chunk_words = chunk_words_;
+  return v;
+}
+
+template <class Real>
+SolidCoverageView<Real> FluidLattice<Real>::solid_coverage() {
+  enable_solid_coverage();
+  return coverage_view();
+}
+
+template <class Real>
+SolidCoverageView<const Real> FluidLattice<Real>::solid_coverage_if_set() const {
+  if (!has_solid_coverage()) return {};
+  const SolidCoverageView<Real> v = coverage_view();
+  SolidCoverageView<const Real> c;
+  c.extent = v.extent;
+  c.coverage = v.coverage;
+  c.density = v.density;
+  for (int d = 0; d < 3; ++d) {
+    c.solid_velocity[d] = v.solid_velocity[d];
+    c.momentum[d] = v.momentum[d];
+  }
+  c.chunks = v.chunks;
+  c.chunk_words = v.chunk_words;
+  return c;
 }
 
 template <class Real>
@@ -395,15 +400,21 @@ std::size_t FluidLattice<Real>::bytes_per_cell_update() const {
 
 template <class Real>
 void FluidLattice<Real>::step() {
-  if (has_force_field())
-    step_kernel<true>();
-  else
-    step_kernel<false>();
+  if (has_solid_coverage()) {
+    if (has_force_field())
+      step_kernel<true, true>();
+    else
+      step_kernel<false, true>();
+  } else if (has_force_field()) {
+    step_kernel<true, false>();
+  } else {
+    step_kernel<false, false>();
+  }
   ++time_step_;
 }
 
 template <class Real>
-template <bool kForceField>
+template <bool kForceField, bool kCoverage>
 void FluidLattice<Real>::step_kernel() {
   const int nx = extent_.nx, ny = extent_.ny, nz = extent_.nz;
   const bool even = time_step_ % 2 == 0;
@@ -420,6 +431,7 @@ void FluidLattice<Real>::step_kernel() {
   const Real* const Fxs = force_x_.get();
   const Real* const Fys = force_y_.get();
   const Real* const Fzs = force_z_.get();
+  const SolidCoverageView<Real> cover = kCoverage ? coverage_view() : SolidCoverageView<Real>{};
 
 #pragma omp parallel for collapse(2) schedule(static)
   for (int z = 0; z < nz; ++z)
@@ -472,12 +484,53 @@ void FluidLattice<Real>::step_kernel() {
                           for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
                         };
 
+      // A cell that spheres partly cover (partially_saturated_collision.hpp):
+      // it reads its coverage and reports the density and momentum it saw.
+      auto update_covered = [&](int x, const Real* const* ld, Real* const* st, int lx,
+                                int sx) FLOCSIM_LAMBDA_ALWAYS_INLINE {
+        Real f[kQ];
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
+        Real Fcx = bx, Fcy = by, Fcz = bz;
+        if constexpr (kForceField) {
+          Fcx += Fx[x];
+          Fcy += Fy[x];
+          Fcz += Fz[x];
+        }
+        const long c = row + x;
+        collide_partially_saturated(f, Fcx, Fcy, Fcz, cover.coverage[c], cover.solid_velocity[0][c],
+                                    cover.solid_velocity[1][c], cover.solid_velocity[2][c], k,
+                                    cover.density[c], cover.momentum[0][c], cover.momentum[1][c],
+                                    cover.momentum[2][c]);
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
+      };
+
       // Interior of the row: every shifted pointer stays inside the row, so
       // the loop is a plain unit-stride sweep the compiler vectorises.
       const int x_begin = even ? 0 : 1;
       const int x_end = even ? nx : nx - 1;
+      if constexpr (kCoverage) {
+        // chunk by chunk: covered chunks take the blended collision
+        const std::uint64_t* chunks =
+            cover.chunk_row(static_cast<long>(y) + static_cast<long>(ny) * z);
+        constexpr int C = SolidCoverageView<Real>::kChunk;
+        for (int x0 = x_begin; x0 < x_end;) {
+          const int chunk = x0 / C;
+          const int x1 = std::min(x_end, (chunk + 1) * C);
+          if (chunks[chunk / 64] >> (chunk % 64) & 1) {
 #pragma omp simd
-      for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
+            for (int x = x0; x < x1; ++x) update_covered(x, load, store, x, x);
+          } else {
+#pragma omp simd
+            for (int x = x0; x < x1; ++x) update(x, load, store, x, x);
+          }
+          x0 = x1;
+        }
+      } else {
+#pragma omp simd
+        for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
+      }
 
       // Odd steps: the two end cells of the row stream across the periodic
       // boundary in x; give them explicitly wrapped pointers.
@@ -491,6 +544,15 @@ void FluidLattice<Real>::step_kernel() {
             const int from = x - cx[i], to = x + cx[i];  // within one cell of the row
             ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
             st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
+          }
+          if constexpr (kCoverage) {
+            const std::uint64_t* chunks =
+                cover.chunk_row(static_cast<long>(y) + static_cast<long>(ny) * z);
+            const int chunk = x / SolidCoverageView<Real>::kChunk;
+            if (chunks[chunk / 64] >> (chunk % 64) & 1) {
+              update_covered(x, ld, st, 0, 0);
+              continue;
+            }
           }
           update(x, ld, st, 0, 0);
         }

@@ -23,6 +23,7 @@
 // rho u = sum_i c_i f_i + F/2. With this split the momentum of the whole box
 // grows by exactly sum_cells F per step.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -64,6 +65,13 @@ class FluidLattice final : public ForcedLiquid<Real> {
   // The per-cell force field (enabled on first use); index with cell_index.
   ForceFieldView<Real> force_field() override;
   ForceFieldView<const Real> force_field_if_set() const override;
+  // Partially saturated cells (forced_liquid.hpp): the per-cell solid
+  // coverage, allocated zero on first use; the kernel then blends the
+  // collision of the covered chunks (partially_saturated_collision.hpp).
+  void enable_solid_coverage();
+  bool has_solid_coverage() const { return coverage_ != nullptr; }
+  SolidCoverageView<Real> solid_coverage() override;
+  SolidCoverageView<const Real> solid_coverage_if_set() const override;
 
   // ---- state ----------------------------------------------------------------
   // Sets every cell to the equilibrium of the given density and (physical,
@@ -109,8 +117,9 @@ class FluidLattice final : public ForcedLiquid<Real> {
   std::size_t bytes_per_cell_update() const;
 
  private:
-  template <bool kForceField>
+  template <bool kForceField, bool kCoverage>
   void step_kernel();
+  SolidCoverageView<Real> coverage_view() const;
   Real* storage(int i) { return populations_.get() + i * stride_; }
   const Real* storage(int i) const { return populations_.get() + i * stride_; }
   // One cell of macroscopic_row_without_force_field (x, y, z inside the box);
@@ -129,6 +138,13 @@ class FluidLattice final : public ForcedLiquid<Real> {
   long stride_ = 0;  // elements between direction arrays (padded)
   Buffer populations_;
   Buffer force_x_, force_y_, force_z_;
+  // solid coverage, one buffer of kCoverageArrays arrays kept coverage_stride_
+  // apart: eps, sum eps u_s (3); the density and momentum the collision saw (4)
+  static constexpr int kCoverageArrays = 8;
+  Buffer coverage_;
+  long coverage_stride_ = 0;
+  std::vector<std::uint64_t> covered_chunks_;
+  int chunk_words_ = 0;
   Vector3 body_force_;
   long time_step_ = 0;
 };

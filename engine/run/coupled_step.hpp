@@ -2,9 +2,13 @@
 // One time step of a sphere scene: the modules the scene composes
 // (cases::SceneModules), each a named stage timed by name, in this order:
 //
-//   immersed_boundary  no-slip forces from the current sphere state, spread
-//                      onto the lattice
-//   fluid              collision and streaming with those forces
+//   coupling           no-slip for the current sphere state: forces spread
+//                      onto the lattice (immersed boundary, timed as
+//                      "immersed_boundary") or the cells' solid fractions
+//                      (partially saturated cells, "partially_saturated")
+//   fluid              collision and streaming with them
+//   (coupling)         the loads of the step, where the scheme measures them
+//                      during the fluid step (timed with the coupling)
 //   spheres            velocities from the hydrodynamic force and torque, net
 //                      gravity and the inside-liquid momentum change
 //   (health)           every sphere's speed, before anything moves them, and
@@ -23,8 +27,9 @@
 #include <vector>
 
 #include "engine/case/suspension_case.hpp"
+#include "engine/coupling/sphere_coupling.hpp"
+#include "engine/coupling_schemes/make_coupling.hpp"
 #include "engine/events/direct_interactions.hpp"
-#include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lubrication/radial_lubrication.hpp"
 #include "engine/run/coupling_monitor.hpp"
@@ -35,7 +40,6 @@ namespace flocsim::run {
 
 // Stage names, as result.json's cost.modules_s reports them.
 namespace stage_name {
-inline constexpr std::string_view immersed_boundary = "immersed_boundary";
 inline constexpr std::string_view fluid = "fluid";
 inline constexpr std::string_view spheres = "spheres";
 inline constexpr std::string_view lubrication = "lubrication";
@@ -46,20 +50,20 @@ inline constexpr std::string_view events = "events";
 template <class Real>
 struct Liquid {
   lattice::FluidLattice<Real> fluid;
-  immersed_boundary::ImmersedBoundary<Real> ib;
+  std::unique_ptr<coupling::SphereCoupling<Real>> coupling;
   spheres::SphereDynamicsSettings dynamics;
   std::vector<std::uint8_t> solid;  // scratch of the liquid averages
 
   explicit Liquid(const cases::SuspensionCase& c)
       : fluid(c.derived.box, {c.numerics.viscosity, c.numerics.trt_magic}),
-        ib({c.numerics.input_radius, c.numerics.ib_scheme, false}) {
+        coupling(coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius)) {
     const double volume = static_cast<double>(c.derived.box.cells());
     dynamics.external = spheres::settling_forces(static_cast<std::size_t>(c.derived.sphere_count),
                                                  c.numerics.radius_cells, c.physics.density_ratio,
                                                  volume, c.derived.gravity);
     dynamics.rigid_inside_liquid = c.numerics.inside_liquid == "rigid-body";
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
-    fluid.enable_force_field();
+    if (c.numerics.coupling.immersed_boundary()) fluid.enable_force_field();
   }
 };
 
@@ -101,7 +105,7 @@ class CoupledStep {
     if (modules_.liquid) {
       liquid_ = std::make_unique<Liquid<Real>>(c);
       if (modules_.spheres_move) coupling_ = std::make_unique<CouplingMonitor>();
-      ib_stage_ = stages.declare(stage_name::immersed_boundary);
+      coupling_stage_ = stages.declare(liquid_->coupling->stage_name());
       fluid_stage_ = stages.declare(stage_name::fluid);
       lubrication_stage_ = stages.declare(stage_name::lubrication);
     }
@@ -117,14 +121,12 @@ class CoupledStep {
   std::string advance(spheres::SphereSet& s) {
     if (liquid_) {
       Liquid<Real>& l = *liquid_;
-      stages_.run(ib_stage_, [&] { l.ib.apply(l.fluid, s); });
+      coupling::SphereCoupling<Real>& coupling = *l.coupling;
+      stages_.run(coupling_stage_, [&] { coupling.apply(l.fluid, s); });
       stages_.run(fluid_stage_, [&] { l.fluid.step(); });
+      stages_.run(coupling_stage_, [&] { coupling.after_liquid_step(l.fluid, s); });
       stages_.run(spheres_stage_, [&] {
-        if (modules_.spheres_move)
-          spheres::advance_velocities(s,
-                                      {l.ib.force(), l.ib.torque(), l.ib.internal_momentum_change(),
-                                       l.ib.internal_angular_momentum_change()},
-                                      l.dynamics);
+        if (modules_.spheres_move) spheres::advance_velocities(s, coupling.loads(), l.dynamics);
       });
     }
     // O(N), well under 1 % of a step
@@ -136,8 +138,8 @@ class CoupledStep {
       const Liquid<Real>& l = *liquid_;
       loads_.resize(s.size());
       for (std::size_t i = 0; i < s.size(); ++i)
-        loads_[i] = spheres::liquid_load_per_step(s, l.dynamics, l.ib.force()[i],
-                                                  l.ib.internal_momentum_change()[i]);
+        loads_[i] = spheres::liquid_load_per_step(s, l.dynamics, l.coupling->force()[i],
+                                                  l.coupling->internal_momentum_change()[i]);
       std::string sick = coupling_->observe(
           loads_, spheres::external_force_per_sphere(l.dynamics.external, s.volume()).norm());
       if (!sick.empty()) return sick;
@@ -169,7 +171,7 @@ class CoupledStep {
   std::unique_ptr<CouplingMonitor> coupling_;
   std::vector<spheres::Vec3> loads_;
   TimedStages& stages_;
-  TimedStages::Id ib_stage_ = 0, fluid_stage_ = 0, spheres_stage_ = 0, lubrication_stage_ = 0,
+  TimedStages::Id coupling_stage_ = 0, fluid_stage_ = 0, spheres_stage_ = 0, lubrication_stage_ = 0,
                   events_stage_ = 0;
 };
 

@@ -7,7 +7,7 @@
 
 #include "engine/case/scene.hpp"
 #include "engine/case/suspension_case.hpp"
-#include "engine/immersed_boundary/scheme.hpp"
+#include "engine/coupling/scheme.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 

@@ -62,9 +62,15 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
       // the first resumed step feeds to the sphere equations
       save_populations(f, liquid->fluid);
       f.set_attribute("/fluid", "time_step", static_cast<std::int64_t>(liquid->fluid.time_step()));
-      f.write("/spheres/internal_momentum", {n, 3}, flatten(liquid->ib.internal_momentum()).data());
+      const coupling::SphereCoupling<Real>& coupling = *liquid->coupling;
+      f.write("/spheres/internal_momentum", {n, 3}, flatten(coupling.internal_momentum()).data());
       f.write("/spheres/internal_angular_momentum", {n, 3},
-              flatten(liquid->ib.internal_angular_momentum()).data());
+              flatten(coupling.internal_angular_momentum()).data());
+      // the coupling scheme's own memory (control forcing: every marker's force)
+      const auto memory = coupling.memory();
+      if (!memory.empty()) f.create_group("/coupling");
+      for (const auto& a : memory)
+        f.write("/coupling/" + a.name, {a.values.size()}, a.values.data());
     }
     f.create_group("/series");
     for (std::size_t col = 0; col < s.series.columns(); ++col)
@@ -122,9 +128,18 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, Spher
   if (liquid) {
     restore_populations(f, liquid->fluid, file);
     liquid->fluid.set_time_step(f.attribute_int("/fluid", "time_step"));
-    liquid->ib.set_internal_momenta(
-        unflatten(f.read<double>("/spheres/internal_momentum")),
-        unflatten(f.read<double>("/spheres/internal_angular_momentum")));
+    coupling::SphereCoupling<Real>& coupling = *liquid->coupling;
+    coupling.set_internal_momenta(unflatten(f.read<double>("/spheres/internal_momentum")),
+                                  unflatten(f.read<double>("/spheres/internal_angular_momentum")));
+    std::vector<coupling::NamedArray> memory = coupling.memory();  // the names it keeps
+    for (auto& a : memory) {
+      const std::string name = "/coupling/" + a.name;
+      if (!f.exists(name))
+        throw std::runtime_error(file.string() + ": holds no " + name + ", which " +
+                                 coupling.scheme().describe() + " needs to resume");
+      a.values = f.read<double>(name);
+    }
+    coupling.restore_memory(memory);
   }
   for (std::size_t col = 0; col < s.series.columns(); ++col) {
     const std::string& column = s.series.names()[col];

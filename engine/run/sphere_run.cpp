@@ -121,7 +121,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
     double balance = l.lattice_momentum_x;
     for (std::size_t i = 0; i < s.spheres.size(); ++i)
       balance += spheres::sphere_balance_momentum(s.spheres, liquid->dynamics, i,
-                                                  liquid->ib.internal_momentum()[i])
+                                                  liquid->coupling->internal_momentum()[i])
                      .x();
     if (!s.momentum_initial_set) {
       // not 0: the first step has no inside-momentum change, while the

@@ -211,7 +211,7 @@ TEST(SuspensionCase, InputRadiusFromTheShippedCalibration) {
 TEST(SuspensionCase, ImmersedBoundarySchemeMustBeCalibrated) {
   const SuspensionCase paper =
       parse_suspension_case({{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}});
-  EXPECT_EQ(paper.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_EQ(paper.numerics.coupling, coupling::kPaperScheme);
   EXPECT_EQ(paper.to_json()["numerics"]["immersed_boundary"],
             json({{"marker_spacing", 0.7}, {"sweeps", 2}, {"kernel", "roma3"}}));
   const json odd = {
@@ -246,12 +246,12 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
                                                          {"fidelity", fidelity},
                                                          {"lubrication_model", "nguyen-ladd"},
                                                          {"phi", 0.2}});
-    EXPECT_EQ(dilute.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+    EXPECT_EQ(dilute.numerics.coupling, coupling::kOneSweepScheme);
     const SuspensionCase dense = parse_suspension_case({{"scene", "suspension"},
                                                         {"fidelity", fidelity},
                                                         {"lubrication_model", "nguyen-ladd"},
                                                         {"phi", 0.25}});
-    EXPECT_EQ(dense.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+    EXPECT_EQ(dense.numerics.coupling, coupling::kPaperScheme);
   }
   // a = 8 (Nguyen-Ladd's correction: no close-pair entry needed): the option's
   // radius is calibrated at nu 0.01-0.04, so the preset takes it
@@ -259,14 +259,14 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
                                                    {"phi", 0.2},
                                                    {"lubrication_model", "nguyen-ladd"},
                                                    {"numerics", {{"a_over_dx", 8}}}});
-  EXPECT_EQ(a8.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  EXPECT_EQ(a8.numerics.coupling, coupling::kOneSweepScheme);
   // where the option is not calibrated near the case's a and viscosity (a = 12
   // has no one-sweep entry)
   const SuspensionCase fine = parse_suspension_case({{"scene", "suspension"},
                                                      {"phi", 0.2},
                                                      {"lubrication_model", "nguyen-ladd"},
                                                      {"numerics", {{"a_over_dx", 12}}}});
-  EXPECT_EQ(fine.numerics.ib_scheme, immersed_boundary::kPaperScheme);
+  EXPECT_EQ(fine.numerics.coupling, coupling::kPaperScheme);
   // a hand-given a_g does not let in a scheme that is not offered
   const json linear = {
       {"scene", "suspension"},
@@ -305,7 +305,7 @@ TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
                     HasSubstr("a_over_dx to 6")));
   json one_sweep = unstable;
   one_sweep["numerics"]["immersed_boundary"] = {{"marker_spacing", 1}, {"sweeps", 1}};
-  EXPECT_EQ(parse_suspension_case(one_sweep).numerics.ib_scheme.sweeps, 1);
+  EXPECT_EQ(parse_suspension_case(one_sweep).numerics.coupling.sweeps, 1);
   // a case that gives the viscosity is told to raise the viscosity
   json given_nu = unstable;
   given_nu["numerics"].erase("U_inf");
@@ -318,12 +318,12 @@ TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
   json held = unstable;
   held["scene"] = "fixed-array";
   held.erase("du_over_Uinf");
-  EXPECT_EQ(parse_suspension_case(held).numerics.ib_scheme.sweeps, 2);
+  EXPECT_EQ(parse_suspension_case(held).numerics.coupling.sweeps, 2);
   // left to defaults, U_inf is raised so that nu sits on the floor (draft at
   // phi 0.25 takes the paper's method; Re_inf 24 would give nu = 0.00667)
   const SuspensionCase by_default = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.25}, {"Re_inf", 24}});
-  EXPECT_EQ(by_default.numerics.ib_scheme.sweeps, 2);
+  EXPECT_EQ(by_default.numerics.coupling.sweeps, 2);
   EXPECT_NEAR(by_default.numerics.viscosity, 0.04 / 3, 1e-15);
   EXPECT_NEAR(by_default.derived.settling_velocity, 0.04, 1e-15);
   // phi above the one-sweep option's validated range: it is not offered
@@ -350,30 +350,29 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
     EXPECT_EQ(c.physics.lubrication_model, "calibrated");
     EXPECT_FALSE(c.numerics.lubrication_lattice_share.empty());
     const double a = c.numerics.radius_cells, nu = c.numerics.viscosity;
-    const bool one_sweep_pairs =
-        pairs.viscosity_gap(a, nu, immersed_boundary::kOneSweepScheme) <= 2.0;
-    EXPECT_EQ(c.numerics.ib_scheme, std::string(fidelity) != "paper" && one_sweep_pairs
-                                        ? immersed_boundary::kOneSweepScheme
-                                        : immersed_boundary::kPaperScheme);
-    EXPECT_LE(pairs.viscosity_gap(a, nu, c.numerics.ib_scheme), 2.0);
+    const bool one_sweep_pairs = pairs.viscosity_gap(a, nu, coupling::kOneSweepScheme) <= 2.0;
+    EXPECT_EQ(c.numerics.coupling, std::string(fidelity) != "paper" && one_sweep_pairs
+                                       ? coupling::kOneSweepScheme
+                                       : coupling::kPaperScheme);
+    EXPECT_LE(pairs.viscosity_gap(a, nu, c.numerics.coupling), 2.0);
   }
   // the paper's viscosities at a = 6 are calibrated for the paper's method
-  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, immersed_boundary::kPaperScheme), 1.0);
+  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, coupling::kPaperScheme), 1.0);
   // and for the one-sweep option, so the standard preset (a = 6) takes it
-  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, immersed_boundary::kOneSweepScheme), 1.0);
+  EXPECT_EQ(pairs.viscosity_gap(6, 0.03, coupling::kOneSweepScheme), 1.0);
   const SuspensionCase standard = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 12}});
-  EXPECT_EQ(standard.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  EXPECT_EQ(standard.numerics.coupling, coupling::kOneSweepScheme);
   const SuspensionCase draft = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2}, {"Re_inf", 12}});
-  EXPECT_EQ(draft.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  EXPECT_EQ(draft.numerics.coupling, coupling::kOneSweepScheme);
   // Re_inf 72 at a = 6 (nu = 0.005, the paper grid's lowest): both schemes'
   // close pairs are calibrated there, so the faster one runs without a warning
   const SuspensionCase fast = parse_suspension_case(
       {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 72}});
   EXPECT_DOUBLE_EQ(fast.numerics.viscosity, 0.005);
-  EXPECT_EQ(fast.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.005, immersed_boundary::kOneSweepScheme), 1.0);
+  EXPECT_EQ(fast.numerics.coupling, coupling::kOneSweepScheme);
+  EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.005, coupling::kOneSweepScheme), 1.0);
   for (const auto& w : fast.warnings)
     EXPECT_EQ(w.find("close-pair calibration"), std::string::npos) << w;
   // nu = 0.1 at a = 6: both schemes' highest entry (0.04) is a factor 2.5 away,
@@ -383,7 +382,7 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
                                                         {"phi", 0.2},
                                                         {"Re_inf", 3},
                                                         {"numerics", {{"viscosity", 0.1}}}});
-  EXPECT_EQ(neither.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
+  EXPECT_EQ(neither.numerics.coupling, coupling::kOneSweepScheme);
   bool gap_named = false;
   for (const auto& w : neither.warnings)
     gap_named =
@@ -394,9 +393,9 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   // preset keeps the one-sweep option there, as at a = 4 and 6
   const SuspensionCase a8 = parse_suspension_case(
       {{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}});
-  EXPECT_EQ(a8.numerics.ib_scheme, immersed_boundary::kOneSweepScheme);
-  EXPECT_LE(pairs.viscosity_gap(8, a8.numerics.viscosity, immersed_boundary::kOneSweepScheme), 2.0);
-  EXPECT_LE(pairs.viscosity_gap(8, a8.numerics.viscosity, immersed_boundary::kPaperScheme), 2.0);
+  EXPECT_EQ(a8.numerics.coupling, coupling::kOneSweepScheme);
+  EXPECT_LE(pairs.viscosity_gap(8, a8.numerics.viscosity, coupling::kOneSweepScheme), 2.0);
+  EXPECT_LE(pairs.viscosity_gap(8, a8.numerics.viscosity, coupling::kPaperScheme), 2.0);
   // a = 12: no close-pair entry; refused with the field, the command and the way out
   EXPECT_THAT(
       refusal({{"scene", "suspension"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 12}}}}),

@@ -50,7 +50,7 @@ void coupled_step(lattice::FluidLattice<Real>& fluid, immersed_boundary::Immerse
 // the lattice by -H, so lattice momentum + sum (m_p - rho V_p) u_p is the
 // conserved sum instead.
 template <class Real>
-void momentum_balance(double tolerance, const immersed_boundary::Scheme& scheme = {},
+void momentum_balance(double tolerance, const coupling::Scheme& scheme = {},
                       bool rigid_inside_liquid = false) {
   const lattice::Extent e{40, 24, 24};
   lattice::FluidLattice<Real> fluid(e, {0.1, 0.25});
@@ -156,11 +156,10 @@ TEST(KickedSphere, RigidBodyInsideLiquidKeepsThreeQuartersOfTheKick) {
 // The other immersed-boundary options spread exactly the reaction of the
 // forces they apply, whatever the kernel or the number of sweeps.
 TEST(MomentumBalance, EveryKernelAndSweepCountConserves) {
-  using immersed_boundary::Kernel;
-  for (const immersed_boundary::Scheme& scheme :
-       {immersed_boundary::Scheme{1.0, 1, Kernel::roma3},
-        immersed_boundary::Scheme{1.0, 1, Kernel::linear2},
-        immersed_boundary::Scheme{0.7, 2, Kernel::linear2}})
+  using coupling::Kernel;
+  for (const coupling::Scheme& scheme :
+       {coupling::Scheme{1.0, 1, Kernel::roma3}, coupling::Scheme{1.0, 1, Kernel::linear2},
+        coupling::Scheme{0.7, 2, Kernel::linear2}})
     momentum_balance<double>(1e-10, scheme);
 }
 

@@ -24,7 +24,7 @@ namespace flocsim {
 namespace {
 
 // K / K_SA - 1 at the given phi (box rounded to whole cells; chi from it).
-double array_error(double a, double phi, const immersed_boundary::Scheme& scheme = {}) {
+double array_error(double a, double phi, const coupling::Scheme& scheme = {}) {
   calibration::ArrayDragSettings s;
   s.scheme = scheme;
   const double ag = test::calibrated_input_radius(a, s.viscosity, scheme);
@@ -128,7 +128,7 @@ struct SettlingSphere {
 // disturbance): U_SN / K_SA(chi_eq) - 2 % <= U_slip <= U_SN + 2 %, with
 // chi_eq = 2a / V_box^(1/3) and 2 % the calibration accuracy. The
 // deviation from U_SN is printed for both box sizes (the box-size effect).
-double settling_velocity_ratio(int W, const immersed_boundary::Scheme& scheme = {}) {
+double settling_velocity_ratio(int W, const coupling::Scheme& scheme = {}) {
   const double a = 4.0, nu = 0.02, re_inf = 12.0;
   const double ag = test::calibrated_input_radius(a, nu, scheme);
   const int L = 2 * W;
@@ -271,7 +271,7 @@ using observables::beetstra_drag;
 // scatter about its data (~10 %, Beetstra et al.) plus the spread between single random
 // configurations of ~100 spheres (a few %). Returns F.
 double static_random_array(double phi, double re_wanted, double nu = 0.02,
-                           const immersed_boundary::Scheme& scheme = {}, double a = 4.0) {
+                           const coupling::Scheme& scheme = {}, double a = 4.0) {
   const int L = static_cast<int>(std::lround(12 * a));
   const double ag = test::calibrated_input_radius(a, nu, scheme);
   const spheres::PeriodicBox box{Vec3(L, L, L)};
@@ -342,8 +342,8 @@ TEST(StaticRandomArray, BeetstraPhi020Re40) {
 // each other option on a frozen random array is compared with the paper
 // scheme's on the identical configuration: that difference is what a user
 // buys by choosing the option (docs/accuracy-cost.md).
-std::vector<immersed_boundary::Scheme> offered_options() {
-  std::vector<immersed_boundary::Scheme> out;
+std::vector<coupling::Scheme> offered_options() {
+  std::vector<coupling::Scheme> out;
   for (const auto& e : calibration::CalibrationTable::shipped().entries()) {
     if (std::abs(e.hydrodynamic_radius - 6.0) > 1e-6) continue;
     bool seen = false;
@@ -353,7 +353,7 @@ std::vector<immersed_boundary::Scheme> offered_options() {
   return out;
 }
 
-class IbOption : public ::testing::TestWithParam<immersed_boundary::Scheme> {};
+class IbOption : public ::testing::TestWithParam<coupling::Scheme> {};
 
 // Sangani & Acrivos over phi = 0.01 - 0.2 at a = 4 and 6, 0.05 - 0.2 at a = 8
 // (0.01 would need a 60^3 box): box sizes the calibration did not use,
@@ -376,12 +376,12 @@ TEST_P(IbOption, SettlingSphereMatchesSchillerNaumannAtRe12) {
 // and 6: within 15 % of Beetstra as above, and the drag's difference from
 // the paper scheme on the same configuration printed for the table.
 TEST_P(IbOption, StaticRandomArrayAgainstBeetstraAndThePaperScheme) {
-  if (GetParam() == immersed_boundary::kPaperScheme)
+  if (GetParam() == coupling::kPaperScheme)
     GTEST_SKIP() << "the paper scheme's own arrays: StaticRandomArray.*";
   static std::map<double, double> paper_drag;  // a -> F with the paper scheme, once per process
   for (double a : {4.0, 6.0}) {
     if (!paper_drag.count(a))
-      paper_drag[a] = static_random_array(0.20, 10, 0.02, immersed_boundary::kPaperScheme, a);
+      paper_drag[a] = static_random_array(0.20, 10, 0.02, coupling::kPaperScheme, a);
     const double paper = paper_drag[a];
     const double option = static_random_array(0.20, 10, 0.02, GetParam(), a);
     std::printf("a = %g: F(%s) / F(paper scheme) - 1 = %+.2f %%\n", a,
@@ -389,8 +389,8 @@ TEST_P(IbOption, StaticRandomArrayAgainstBeetstraAndThePaperScheme) {
   }
 }
 
-std::string option_name(const ::testing::TestParamInfo<immersed_boundary::Scheme>& info) {
-  std::string n = immersed_boundary::kernel_name(info.param.kernel) + "_spacing" +
+std::string option_name(const ::testing::TestParamInfo<coupling::Scheme>& info) {
+  std::string n = coupling::kernel_name(info.param.kernel) + "_spacing" +
                   std::to_string(static_cast<int>(std::lround(100 * info.param.marker_spacing))) +
                   "_sweeps" + std::to_string(info.param.sweeps);
   return n;

@@ -12,7 +12,7 @@ namespace flocsim::test {
 // into the build (engine/calibration/hydrodynamic_radius.json), interpolated in
 // log nu: the very call the solver makes (suspension_case.cpp).
 inline double calibrated_input_radius(double a, double viscosity,
-                                      const immersed_boundary::Scheme& scheme = {}) {
+                                      const coupling::Scheme& scheme = {}) {
   return calibration::CalibrationTable::shipped().input_radius(a, viscosity, scheme);
 }
 

@@ -189,7 +189,7 @@ TEST(CalibrationTable, InputRadiusInterpolatesInLogViscosityAndNeverExtrapolates
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.04), 5.59);
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.005), 5.57);  // outside: the nearest entry
   EXPECT_DOUBLE_EQ(table.input_radius(6, 0.5), 5.59);
-  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, {0.7, 1, immersed_boundary::Kernel::roma3}),
+  EXPECT_DOUBLE_EQ(table.input_radius(6, 0.02, {0.7, 1, coupling::Kernel::roma3}),
                    5.00);  // sweeps are a separate scheme
   EXPECT_DOUBLE_EQ(table.input_radius(4, 0.001), 3.53);
   EXPECT_THROW(table.input_radius(5, 0.02), std::out_of_range);
@@ -414,10 +414,10 @@ struct ReferenceResult {
 
 ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
                                 const spheres::SphereSet& s, double ag,
-                                const immersed_boundary::Scheme& scheme) {
+                                const coupling::Scheme& scheme) {
   const lattice::Extent e = fluid.extent();
   const int n = immersed_boundary::marker_count(ag, scheme.marker_spacing);
-  const bool roma = scheme.kernel == immersed_boundary::Kernel::roma3;
+  const bool roma = scheme.kernel == coupling::Kernel::roma3;
   const int width = roma ? 3 : 2;
   // Roma: cells round(X) - 1 .. round(X) + 1; linear: floor(X), floor(X) + 1
   const auto first_cell = [roma](double X) {
@@ -516,10 +516,10 @@ ReferenceResult reference_apply(const lattice::FluidLattice<double>& fluid,
   return out;
 }
 
-class ReferenceScheme : public ::testing::TestWithParam<immersed_boundary::Scheme> {};
+class ReferenceScheme : public ::testing::TestWithParam<coupling::Scheme> {};
 
 TEST_P(ReferenceScheme, MatchesAPlainReferenceImplementation) {
-  const immersed_boundary::Scheme scheme = GetParam();
+  const coupling::Scheme scheme = GetParam();
   const lattice::Extent e{44, 36, 34};
   lattice::FluidLattice<double> fluid(e, {0.1, 0.25});
   fluid.set_body_force({2e-6, -1e-6, 0});
@@ -567,19 +567,18 @@ TEST_P(ReferenceScheme, MatchesAPlainReferenceImplementation) {
 }
 
 // The paper's scheme, one sweep, wider markers and the 2-point kernel.
-INSTANTIATE_TEST_SUITE_P(
-    Schemes, ReferenceScheme,
-    ::testing::Values(immersed_boundary::Scheme{0.7, 2, immersed_boundary::Kernel::roma3},
-                      immersed_boundary::Scheme{1.0, 1, immersed_boundary::Kernel::roma3},
-                      immersed_boundary::Scheme{0.7, 3, immersed_boundary::Kernel::roma3},
-                      immersed_boundary::Scheme{1.0, 1, immersed_boundary::Kernel::linear2},
-                      immersed_boundary::Scheme{0.7, 2, immersed_boundary::Kernel::linear2}),
-    [](const ::testing::TestParamInfo<immersed_boundary::Scheme>& param_info) {
-      const auto& p = param_info.param;
-      return immersed_boundary::kernel_name(p.kernel) + "_spacing" +
-             std::to_string(static_cast<int>(10 * p.marker_spacing)) + "_sweeps" +
-             std::to_string(p.sweeps);
-    });
+INSTANTIATE_TEST_SUITE_P(Schemes, ReferenceScheme,
+                         ::testing::Values(coupling::Scheme{0.7, 2, coupling::Kernel::roma3},
+                                           coupling::Scheme{1.0, 1, coupling::Kernel::roma3},
+                                           coupling::Scheme{0.7, 3, coupling::Kernel::roma3},
+                                           coupling::Scheme{1.0, 1, coupling::Kernel::linear2},
+                                           coupling::Scheme{0.7, 2, coupling::Kernel::linear2}),
+                         [](const ::testing::TestParamInfo<coupling::Scheme>& param_info) {
+                           const auto& p = param_info.param;
+                           return coupling::kernel_name(p.kernel) + "_spacing" +
+                                  std::to_string(static_cast<int>(10 * p.marker_spacing)) +
+                                  "_sweeps" + std::to_string(p.sweeps);
+                         });
 
 // The float lattice runs the same method in single precision (populations,
 // u*, marker sweeps): for the same flow its forces, torques and inside momenta

@@ -33,7 +33,7 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6LowViscosity) {
 }
 
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6LowViscosity) {
-  expect_total_near_brenner(6, 0.014, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+  expect_total_near_brenner(6, 0.014, kFewGaps, 14, coupling::kOneSweepScheme, "standard");
 }
 
 // a = 6 at nu = 0.0075, between the 0.005 and 0.01 entries: the paper's grid
@@ -44,8 +44,7 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA6Re48) {
 }
 
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6Re48) {
-  expect_total_near_brenner(6, 0.0075, kFewGaps, 14, immersed_boundary::kOneSweepScheme,
-                            "standard");
+  expect_total_near_brenner(6, 0.0075, kFewGaps, 14, coupling::kOneSweepScheme, "standard");
 }
 
 // a = 8 (calibrated at 0.01, 0.02 and 0.04 in a 12a box) measured again at
@@ -57,15 +56,15 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA8) {
 // The one-sweep option at a = 8 (calibrated at 0.01, 0.02 and 0.04 in a 12a
 // box) measured again at 0.03 in a 14a box.
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA8) {
-  expect_total_near_brenner(8, 0.03, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+  expect_total_near_brenner(8, 0.03, kFewGaps, 14, coupling::kOneSweepScheme, "standard");
 }
 
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA4) {
-  expect_total_near_brenner(4, 0.03, kFewGaps, 20, immersed_boundary::kOneSweepScheme, "standard");
+  expect_total_near_brenner(4, 0.03, kFewGaps, 20, coupling::kOneSweepScheme, "standard");
 }
 
 TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6) {
-  expect_total_near_brenner(6, 0.03, kFewGaps, 14, immersed_boundary::kOneSweepScheme, "standard");
+  expect_total_near_brenner(6, 0.03, kFewGaps, 14, coupling::kOneSweepScheme, "standard");
 }
 
 }  // namespace

@@ -20,8 +20,7 @@ namespace flocsim::lubrication {
 
 // A suspension case at a_over_dx = a, lattice viscosity nu (Re_inf set so
 // that U_inf = 0.01) and IB scheme; its lubrication as the run builds it.
-inline RadialLubrication lubrication_of_case(double a, double nu,
-                                             const immersed_boundary::Scheme& scheme,
+inline RadialLubrication lubrication_of_case(double a, double nu, const coupling::Scheme& scheme,
                                              const std::string& fidelity) {
   const auto c = cases::parse_suspension_case(
       {{"scene", "suspension"},
@@ -33,7 +32,7 @@ inline RadialLubrication lubrication_of_case(double a, double nu,
         {{"a_over_dx", a},
          {"viscosity", nu},
          {"immersed_boundary", cases::immersed_boundary_json(scheme)}}}});
-  EXPECT_EQ(c.numerics.ib_scheme, scheme);
+  EXPECT_EQ(c.numerics.coupling, scheme);
   return RadialLubrication({.viscosity = c.numerics.viscosity,
                             .onset_gap = c.physics.lubrication_onset_over_a,
                             .saturation_gap = c.physics.lubrication_saturation_over_a,
@@ -46,8 +45,7 @@ inline RadialLubrication lubrication_of_case(double a, double nu,
 // pass, each from the flow of the one before, and the box offset of this box
 // is read at s = 0.5a like the calibration's.
 inline void expect_total_near_brenner(double a, double nu, const std::vector<double>& gaps,
-                                      double box_over_a = 20,
-                                      const immersed_boundary::Scheme& scheme = {},
+                                      double box_over_a = 20, const coupling::Scheme& scheme = {},
                                       const std::string& fidelity = "paper") {
   const RadialLubrication lub = lubrication_of_case(a, nu, scheme, fidelity);
   calibration::PairResistanceSettings set{
