@@ -74,10 +74,14 @@ namespace {
 // viscosity, is not repeated).
 class ArrayFlow {
  public:
-  ArrayFlow(int box, const ArrayDragSettings& settings)
-      : box_(box), settings_(settings), fluid_({box, box, box}, {settings.viscosity, 0.25}) {
+  ArrayFlow(int box, const ArrayDragSettings& settings, double grid_offset)
+      : box_(box),
+        grid_offset_(grid_offset),
+        settings_(settings),
+        fluid_({box, box, box}, {settings.viscosity, 0.25}) {
     sphere_.resize(1);
-    sphere_.position[0] = spheres::Vec3::Constant(0.5 * box);
+    sphere_.position[0] =
+        spheres::Vec3::Constant(grid_offset < 0 ? 0.5 * box : box / 2 + grid_offset);
   }
 
   ArrayDragResult run_to_steady(double input_radius) {
@@ -96,6 +100,7 @@ class ArrayFlow {
     ArrayDragResult r;
     r.input_radius = input_radius;
     r.box = box_;
+    r.grid_offset = grid_offset_;
     r.body_force = body_force;
     constexpr int kCheck = 100;
     double previous = 0;
@@ -127,6 +132,7 @@ class ArrayFlow {
 
  private:
   int box_;
+  double grid_offset_;
   ArrayDragSettings settings_;
   lattice::FluidLattice<double> fluid_;
   spheres::SphereSet sphere_;
@@ -136,8 +142,26 @@ class ArrayFlow {
 }  // namespace
 
 ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
-                                        const ArrayDragSettings& settings) {
-  return ArrayFlow(box, settings).run_to_steady(input_radius);
+                                        const ArrayDragSettings& settings, double grid_offset) {
+  return ArrayFlow(box, settings, grid_offset).run_to_steady(input_radius);
+}
+
+std::vector<std::pair<int, double>> CalibrationEntry::box_radii() const {
+  std::vector<std::pair<int, double>> radii;
+  std::vector<int> runs;
+  for (const auto& c : checks) {
+    auto it =
+        std::find_if(radii.begin(), radii.end(), [&](const auto& r) { return r.first == c.box; });
+    if (it == radii.end()) {
+      radii.emplace_back(c.box, 0.0);
+      runs.push_back(0);
+      it = radii.end() - 1;
+    }
+    it->second += c.hydrodynamic_radius;
+    ++runs[static_cast<std::size_t>(it - radii.begin())];
+  }
+  for (std::size_t k = 0; k < radii.size(); ++k) radii[k].second /= runs[k];
+  return radii;
 }
 
 CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::vector<int>& boxes,
@@ -149,7 +173,10 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
   e.viscosity = settings.viscosity;
   e.scheme = settings.scheme;
   std::vector<std::unique_ptr<ArrayFlow>> flows;
-  for (int L : boxes) flows.push_back(std::make_unique<ArrayFlow>(L, settings));
+  const std::vector<double> offsets =
+      settings.grid_offsets.empty() ? std::vector<double>{-1.0} : settings.grid_offsets;
+  for (int L : boxes)
+    for (double d : offsets) flows.push_back(std::make_unique<ArrayFlow>(L, settings, d));
   double ag = hydrodynamic_radius - 0.3;  // typical offset, refined below
   for (int pass = 0; pass < 3; ++pass) {
     e.checks.clear();
@@ -159,7 +186,7 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
       if (progress) progress(e.checks.back());
       mean_offset += e.checks.back().hydrodynamic_radius - ag;
     }
-    mean_offset /= static_cast<double>(boxes.size());
+    mean_offset /= static_cast<double>(flows.size());
     e.input_radius = ag;
     const double miss = ag + mean_offset - hydrodynamic_radius;
     if (pass > 0 && std::abs(miss) <= 0.01) break;
@@ -170,7 +197,7 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
 
 namespace {
 nlohmann::json to_json(const ArrayDragResult& r, double viscosity) {
-  return {
+  nlohmann::json j = {
       {"box", r.box},
       {"chi", 2.0 * r.hydrodynamic_radius / r.box},
       {"body_force", r.body_force},
@@ -179,6 +206,8 @@ nlohmann::json to_json(const ArrayDragResult& r, double viscosity) {
       {"hydrodynamic_radius", r.hydrodynamic_radius},
       {"K_with_input_radius", r.drag_coefficient(r.input_radius, viscosity)},
       {"K_sangani_acrivos_at_input_radius", sangani_acrivos_drag(2.0 * r.input_radius / r.box)}};
+  if (r.grid_offset >= 0) j["grid_offset"] = r.grid_offset;
+  return j;
 }
 }  // namespace
 
@@ -252,6 +281,7 @@ CalibrationTable CalibrationTable::parse(const std::string& json_text, const std
       r.superficial_velocity = jc.at("superficial_velocity").get<double>();
       r.steps = jc.at("steps").get<long>();
       r.hydrodynamic_radius = jc.at("hydrodynamic_radius").get<double>();
+      r.grid_offset = jc.value("grid_offset", -1.0);
       e.checks.push_back(r);
     }
     t.entries_.push_back(e);

@@ -35,11 +35,19 @@ struct ArrayDragSettings {
   double superficial_velocity = 1e-4;  // sets the body force through the reference K; Re << 1
   double tolerance = 1e-6;             // relative change of U per 100 steps at steady state
   long max_steps = 400000;
+  // Where the sphere sits on the grid. Empty: at the cube's centre, 0.5 L in
+  // each direction (how the direct-forcing entries were made). Otherwise one
+  // run per value d, the centre at floor(L/2) + d in each direction (d = 0: on
+  // a lattice node, 0.5: in the middle of a cell), and a box's hydrodynamic
+  // radius is the mean over them: the radius a moving sphere has on average,
+  // for schemes whose boundary depends on where it sits on the grid.
+  std::vector<double> grid_offsets;
 };
 
 struct ArrayDragResult {
   double input_radius = 0;
   int box = 0;                      // L
+  double grid_offset = -1;          // d of ArrayDragSettings::grid_offsets; -1: centred at 0.5 L
   double body_force = 0;            // f
   double superficial_velocity = 0;  // U
   double ib_force = 0;              // |H_x| on the sphere at the end (equals f L^3 when steady)
@@ -49,10 +57,11 @@ struct ArrayDragResult {
   double drag_coefficient(double a, double viscosity) const;
 };
 
-// One fixed sphere of input radius a_g centred in a periodic cube of edge L,
-// creeping flow driven along x, run to a steady state (double precision).
+// One fixed sphere of input radius a_g centred in a periodic cube of edge L
+// (at floor(L/2) + grid_offset when that is >= 0), creeping flow driven along
+// x, run to a steady state (double precision).
 ArrayDragResult simple_cubic_array_drag(double input_radius, int box,
-                                        const ArrayDragSettings& settings);
+                                        const ArrayDragSettings& settings, double grid_offset = -1);
 
 // The radius a for which F / (6 pi nu a U) = K_SA(2a/L).
 double hydrodynamic_radius_from_drag(double force, double superficial_velocity, double viscosity,
@@ -65,6 +74,9 @@ struct CalibrationEntry {
   double input_radius = 0;  // a_g (dx)
   coupling::Scheme scheme;
   std::vector<ArrayDragResult> checks;  // the runs with the final a_g
+  // The hydrodynamic radius each box gave: the mean over its runs (one per
+  // grid offset), in the order the boxes were first run.
+  std::vector<std::pair<int, double>> box_radii() const;
 };
 
 // Finds a_g for the wanted a: runs the boxes with a first guess, shifts a_g by

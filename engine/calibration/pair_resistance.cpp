@@ -284,9 +284,7 @@ std::string close_pair_calibrate_command(double a, double nu, const coupling::Sc
   std::ostringstream cmd;
   cmd << "flocsim calibrate --close-pairs --radius " << a << " --viscosity " << nu;
   if (a >= 6) cmd << " --pair-box 12";
-  cmd << " --marker-spacing " << scheme.marker_spacing << " --sweeps " << scheme.sweeps
-      << " --kernel " << coupling::kernel_name(scheme.kernel)
-      << " --table engine/calibration/pair_resistance.json";
+  cmd << calibrate_options(scheme) << " --table engine/calibration/pair_resistance.json";
   return cmd.str();
 }
 

@@ -7,6 +7,7 @@
 // kernel (none: Roma's, from before the kernel was a choice). Control gains
 // are not part of an entry's identity (they do not change the calibration);
 // the entry records those it was made with.
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -52,6 +53,19 @@ inline void write_scheme(nlohmann::json& entry, const coupling::Scheme& scheme) 
     entry["gains"] = {{"integral", scheme.gains.integral},
                       {"proportional", scheme.gains.proportional}};
   }
+}
+
+// The `flocsim calibrate` options that name this scheme: " --marker-spacing 1
+// --sweeps 1 --kernel roma3", " --forcing control --marker-spacing 0.7
+// --kernel roma3", " --coupling partially-saturated".
+inline std::string calibrate_options(const coupling::Scheme& scheme) {
+  if (!scheme.immersed_boundary()) return " --coupling " + coupling::method_name(scheme.method);
+  char spacing[32];
+  std::snprintf(spacing, sizeof spacing, "%g", scheme.marker_spacing);
+  std::string o = scheme.control() ? " --forcing control" : "";
+  o += std::string(" --marker-spacing ") + spacing;
+  if (!scheme.control()) o += " --sweeps " + std::to_string(scheme.sweeps);
+  return o + " --kernel " + coupling::kernel_name(scheme.kernel);
 }
 
 }  // namespace flocsim::calibration

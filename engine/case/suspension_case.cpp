@@ -7,6 +7,7 @@
 
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/calibration/pair_resistance.hpp"
+#include "engine/calibration/table_scheme.hpp"
 #include "engine/case/case_support.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -44,24 +45,72 @@ Preset preset(const std::string& fidelity) {
   return {6, 48, 30, 150, 100, 300, kPaperScheme};  // paper
 }
 
-// numerics.immersed_boundary: {"marker_spacing", "sweeps", "kernel"}, each
-// defaulting to the preset's value.
-coupling::Scheme read_ib_scheme(InputReader& numerics, const coupling::Scheme& preset_scheme) {
+// numerics.coupling ("immersed-boundary", the default, or
+// "partially-saturated") and, for the immersed boundary,
+// numerics.immersed_boundary: {"marker_spacing", "sweeps", "kernel",
+// "forcing", "gains"}, each defaulting to the preset's value (control forcing:
+// to the paper's markers, 0.7 dx, and the measured default gains).
+coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& preset_scheme) {
+  const std::string method = numerics.choice("coupling", coupling::method_names(),
+                                             coupling::method_name(preset_scheme.method));
+  if (method == coupling::method_name(coupling::Method::partially_saturated)) {
+    if (numerics.has("immersed_boundary"))
+      throw InputError(
+          "numerics.immersed_boundary: only with numerics.coupling = \"immersed-boundary\" "
+          "(numerics.coupling = \"partially-saturated\" has no markers)");
+    return coupling::kPartiallySaturatedScheme;
+  }
   coupling::Scheme scheme = preset_scheme;
+  scheme.method = coupling::Method::immersed_boundary;
   if (!numerics.has("immersed_boundary")) return scheme;
   InputReader ib = numerics.object("immersed_boundary");
+  scheme.forcing = *coupling::forcing_from_name(ib.choice(
+      "forcing", coupling::forcing_names(), coupling::forcing_name(coupling::Forcing::direct)));
+  const coupling::Scheme& defaults = scheme.control() ? coupling::kControlScheme : preset_scheme;
   scheme.marker_spacing =
-      ib.number("marker_spacing", {.above = 0.2, .at_most = 1.5}, preset_scheme.marker_spacing);
-  scheme.sweeps =
-      static_cast<int>(ib.integer("sweeps", {.at_least = 1, .at_most = 20}, preset_scheme.sweeps));
+      ib.number("marker_spacing", {.above = 0.2, .at_most = 1.5}, defaults.marker_spacing);
   scheme.kernel = *coupling::kernel_from_name(
-      ib.choice("kernel", coupling::kernel_names(), coupling::kernel_name(preset_scheme.kernel)));
+      ib.choice("kernel", coupling::kernel_names(), coupling::kernel_name(defaults.kernel)));
+  if (scheme.control()) {
+    if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
+      throw InputError(
+          "numerics.immersed_boundary.sweeps: control forcing makes one correction "
+          "per step (1)");
+    scheme.sweeps = 1;
+    scheme.gains = coupling::kControlScheme.gains;
+    if (ib.has("gains")) {
+      InputReader g = ib.object("gains");
+      scheme.gains.integral =
+          g.number("integral", {.above = 0, .at_most = 100}, scheme.gains.integral);
+      scheme.gains.proportional =
+          g.number("proportional", {.at_least = 0, .at_most = 100}, scheme.gains.proportional);
+      if (!coupling::stable_gains(scheme.gains))
+        throw InputError(
+            "numerics.immersed_boundary.gains = {integral " + format_value(scheme.gains.integral) +
+            ", proportional " + format_value(scheme.gains.proportional) +
+            "}: outside the region where control forcing was measured stable: integral >= " +
+            format_value(coupling::kSmallestIntegralGain) +
+            ", proportional >= 0, integral + 2 proportional <= " +
+            format_value(coupling::kLargestPeriodTwoGain) +
+            " (a settling sphere shakes itself apart in a period-2 mode at 4; docs/coupling.md)");
+      g.finish();
+    }
+  } else {
+    if (ib.has("gains"))
+      throw InputError("numerics.immersed_boundary.gains: only with \"forcing\": \"control\"");
+    scheme.sweeps =
+        static_cast<int>(ib.integer("sweeps", {.at_least = 1, .at_most = 20}, defaults.sweeps));
+  }
   ib.finish();
   return scheme;
 }
 
 // "{marker_spacing 1, sweeps 1, kernel roma3}"
 std::string scheme_fields(const coupling::Scheme& s) {
+  if (!s.immersed_boundary()) return "{coupling partially-saturated}";
+  if (s.control())
+    return "{forcing control, marker_spacing " + format_value(s.marker_spacing) + ", kernel " +
+           coupling::kernel_name(s.kernel) + "}";
   return "{marker_spacing " + format_value(s.marker_spacing) + ", sweeps " +
          std::to_string(s.sweeps) + ", kernel " + coupling::kernel_name(s.kernel) + "}";
 }
@@ -247,7 +296,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
            pair_gap(preset_scheme) > kNearViscosityFactor &&
            pair_gap(coupling::kPaperScheme) < pair_gap(preset_scheme)))
         preset_scheme = coupling::kPaperScheme;
-      return read_ib_scheme(num, preset_scheme);
+      return read_coupling(num, preset_scheme);
     };
     c.numerics.coupling = choose_scheme();
     // By default also stay clear of the multi-sweep coupling's oscillation
@@ -319,7 +368,7 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     bool offered = false;
     std::string names;
     for (const auto& e : table.entries()) {
-      offered = offered || e.scheme == c.numerics.coupling;
+      offered = offered || e.scheme.same_calibration(c.numerics.coupling);
       const std::string n = scheme_fields(e.scheme);
       if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
     }
@@ -338,10 +387,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
           "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
           ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
           c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
-          format_value(a) + " --viscosity NU --marker-spacing " +
-          format_value(c.numerics.coupling.marker_spacing) + " --sweeps " +
-          std::to_string(c.numerics.coupling.sweeps) + " --kernel " +
-          coupling::kernel_name(c.numerics.coupling.kernel) +
+          format_value(a) + " --viscosity NU" +
+          calibration::calibrate_options(c.numerics.coupling) +
           " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
           "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
     try {
@@ -528,8 +575,14 @@ nlohmann::json SuspensionCase::to_json() const {
   j["numerics"] = {{"a_over_dx", numerics.radius_cells},
                    {"viscosity", numerics.viscosity},
                    {"trt_magic", numerics.trt_magic}};
-  if (modules_of(scene).liquid)
-    j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.coupling);
+  if (modules_of(scene).liquid) {
+    // written only when not the default, so that every case that predates the
+    // choice keeps its identity
+    if (numerics.coupling.immersed_boundary())
+      j["numerics"]["immersed_boundary"] = immersed_boundary_json(numerics.coupling);
+    else
+      j["numerics"]["coupling"] = coupling::method_name(numerics.coupling.method);
+  }
   if (numerics.input_radius_given) j["numerics"]["input_radius"] = numerics.input_radius;
   // written only when not the default, so that every case that predates the
   // option keeps its identity
@@ -573,6 +626,12 @@ nlohmann::json SuspensionCase::derived_json() const {
 }
 
 nlohmann::json immersed_boundary_json(const coupling::Scheme& scheme) {
+  if (scheme.control())
+    return {{"forcing", coupling::forcing_name(scheme.forcing)},
+            {"marker_spacing", scheme.marker_spacing},
+            {"kernel", coupling::kernel_name(scheme.kernel)},
+            {"gains",
+             {{"integral", scheme.gains.integral}, {"proportional", scheme.gains.proportional}}}};
   return {{"marker_spacing", scheme.marker_spacing},
           {"sweeps", scheme.sweeps},
           {"kernel", coupling::kernel_name(scheme.kernel)}};

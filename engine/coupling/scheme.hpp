@@ -86,18 +86,39 @@ inline std::optional<Forcing> forcing_from_name(const std::string& name) {
 // would remove the slip e of an isolated marker in one step (2 rho e): each
 // step the marker force changes by rho (integral e + proportional (e - e_prev)).
 // With integral = 2 and proportional = 0 an isolated marker is forced exactly
-// as one direct-forcing sweep would; at steady state any stable gains leave
+// as one direct-forcing sweep would. At a steady state any stable gains leave
 // no slip at the markers (the integral action), so the calibration does not
-// depend on them. The defaults and the region accepted are measured
-// (docs/coupling.md, "Control forcing: where it is stable").
+// depend on them.
+//
+// Where the loop is stable was measured (docs/coupling.md, "Control forcing:
+// where it is stable"; bench_control_stability, 1e5 steps per point, a = 4 at
+// nu 0.01-0.04 and a = 6 at nu 0.005-0.02, a sphere held in a flow and one
+// settling at Re 12): held spheres are stable up to the largest gains tried
+// (integral 4); a settling sphere goes unstable within 100 steps, in a
+// period-2 mode, once the loop's gain at that frequency, integral +
+// 2 proportional, reaches 4 (integral 4; integral 2 with proportional 1),
+// and stays bounded at 3 (integral 3; integral 1 with proportional 1). One
+// run with integral 0.5 blew up after 68 000 steps at a = 6, nu = 0.005,
+// where 0.1 and 1 did not, so gains below 1 are not offered. Accepted:
+// 1 <= integral, 0 <= proportional, integral + 2 proportional <= 3.
+// Default: integral 2 (one direct-forcing sweep for an isolated marker, the
+// smallest slip of the gains with a margin of almost 2 to the edge),
+// proportional 0 (it did not lower the slip measurably).
 struct ControlGains {
-  double integral = 0.5;
+  double integral = 2.0;
   double proportional = 0.0;
   bool operator==(const ControlGains& o) const {
     return std::abs(integral - o.integral) <= 1e-12 &&
            std::abs(proportional - o.proportional) <= 1e-12;
   }
 };
+inline constexpr double kSmallestIntegralGain = 1.0;
+inline constexpr double kLargestPeriodTwoGain = 3.0;  // integral + 2 proportional
+// Whether the gains lie where the loop was measured stable.
+inline bool stable_gains(const ControlGains& g) {
+  return g.integral >= kSmallestIntegralGain && g.proportional >= 0 &&
+         g.integral + 2 * g.proportional <= kLargestPeriodTwoGain * (1 + 1e-12);
+}
 
 struct Scheme {
   // Immersed boundary only:

@@ -256,25 +256,29 @@ struct ImmersedBoundary<Real>::SphereWork {
                               Prefetcher& fetch) const {
     const coupling::ControlGains& g = ib.settings_.scheme.gains;
     const Real dVr = static_cast<Real>(dV);
-    const std::size_t first = static_cast<std::size_t>(s) * markers;
-    V4* carried = reinterpret_cast<V4*>(&ib.marker_force_[4 * first]);
-    V4* slip = reinterpret_cast<V4*>(&ib.marker_slip_[4 * first]);
+    // the carried forces and slips, (0, x, y, z) per marker (plain numbers in
+    // memory, so loaded and stored as vectors without alignment assumptions)
+    Real* carried = &ib.marker_force_[4 * static_cast<std::size_t>(s) * markers];
+    Real* slips = &ib.marker_slip_[4 * static_cast<std::size_t>(s) * markers];
     // v = u* + F_last / (2 rho) on the sphere's cells
-    for (int m = 0; m < markers; ++m) {
-      const std::size_t k = static_cast<std::size_t>(m);
-      ws.increment[k] = carried[k] * dVr;
-    }
+    for (int m = 0; m < markers; ++m)
+      ws.increment[static_cast<std::size_t>(m)] =
+          Simd<Real>::template load<V4>(carried + 4 * m) * dVr;
     spread_increments(ws);
     update_state(ws, rows);
     clear_force(ws, rows);
     for (int m = 0; m < markers; ++m) {
       fetch();
       const std::size_t k = static_cast<std::size_t>(m);
-      carried[k] +=
+      V4 slip = Simd<Real>::template load<V4>(slips + 4 * m);
+      const V4 force =
+          Simd<Real>::template load<V4>(carried + 4 * m) +
           control_increment(stencil.interpolate(ws.state.data(), ws.base[k], ws.weights[k]),
-                            ws.target[k], slip[k], g.integral, g.proportional);
-      ws.marker_force[k] = carried[k];
-      ws.increment[k] = carried[k] * dVr;
+                            ws.target[k], slip, g.integral, g.proportional);
+      Simd<Real>::store(carried + 4 * m, force);
+      Simd<Real>::store(slips + 4 * m, slip);
+      ws.marker_force[k] = force;
+      ws.increment[k] = force * dVr;
     }
     spread_increments(ws);
     if (ib.settings_.measure_slip) update_state(ws, rows);

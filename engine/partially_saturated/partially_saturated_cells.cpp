@@ -149,12 +149,13 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
                                           const spheres::SphereSet& spheres) {
   const lattice::Extent e = liquid.extent();
   const int length[3] = {e.nx, e.ny, e.nz};
+  const double reach = input_radius_ + kHalfDiagonal;
   for (int d = 0; d < 3; ++d)
-    if (length[d] <= box_)
-      throw std::invalid_argument("partially saturated cells: box length " +
-                                  std::to_string(length[d]) + " must exceed a sphere's cell box, " +
-                                  std::to_string(box_) +
-                                  " (a sphere must not cover its own periodic image)");
+    if (length[d] <= 2 * reach + 1)
+      throw std::invalid_argument(
+          "partially saturated cells: box length " + std::to_string(length[d]) +
+          " must exceed 2 (a_g + sqrt(3)/2) + 1 = " + std::to_string(2 * reach + 1) +
+          " (a sphere must not cover its own periodic image)");
   const lattice::SolidCoverageView<Real> view = liquid.solid_coverage();
   locate(spheres);
   const auto colours = coupling::make_colours(origins_, box_, e);

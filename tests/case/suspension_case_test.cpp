@@ -485,3 +485,46 @@ TEST(SuspensionCaseRefusals, ViscosityBelowTheStableRangeIsRefusedUpFront) {
 
 }  // namespace
 }  // namespace flocsim::cases
+
+namespace flocsim::cases {
+namespace {
+
+// The coupling a case may choose (engine/coupling/scheme.hpp): control
+// forcing's gains only where they were measured stable, named with the
+// region; its one correction per step; the partially saturated cells without
+// markers; each option only with its method.
+TEST(SuspensionCaseCoupling, OptionsOfOneMethodAreRefusedWithTheOther) {
+  const json base = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+  json psm_with_markers = base;
+  psm_with_markers["numerics"] = {{"coupling", "partially-saturated"},
+                                  {"immersed_boundary", {{"sweeps", 1}}}};
+  EXPECT_THAT(refusal(psm_with_markers),
+              AllOf(HasSubstr("numerics.immersed_boundary"), HasSubstr("partially-saturated")));
+  json gains_with_direct = base;
+  gains_with_direct["numerics"] = {{"immersed_boundary", {{"gains", {{"integral", 2}}}}}};
+  EXPECT_THAT(refusal(gains_with_direct),
+              AllOf(HasSubstr("numerics.immersed_boundary.gains"), HasSubstr("control")));
+  json control_sweeps = base;
+  control_sweeps["numerics"] = {{"immersed_boundary", {{"forcing", "control"}, {"sweeps", 2}}}};
+  EXPECT_THAT(refusal(control_sweeps), HasSubstr("sweeps"));
+  json unknown = base;
+  unknown["numerics"] = {{"coupling", "momentum-exchange"}};
+  EXPECT_THAT(refusal(unknown),
+              AllOf(HasSubstr("numerics.coupling"), HasSubstr("momentum-exchange"),
+                    HasSubstr("partially-saturated")));
+}
+
+TEST(SuspensionCaseCoupling, ControlGainsOutsideTheMeasuredStableRegionAreRefused) {
+  for (const auto& [g, p] : std::vector<std::pair<double, double>>{{4, 0}, {2, 1}, {0.5, 0}}) {
+    json c = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+    c["numerics"] = {{"immersed_boundary",
+                      {{"forcing", "control"}, {"gains", {{"integral", g}, {"proportional", p}}}}}};
+    EXPECT_THAT(refusal(c),
+                AllOf(HasSubstr("numerics.immersed_boundary.gains"), HasSubstr("integral >= 1"),
+                      HasSubstr("integral + 2 proportional <= 3")))
+        << g << ", " << p;
+  }
+}
+
+}  // namespace
+}  // namespace flocsim::cases
