@@ -55,6 +55,26 @@ std::string range_text(const std::string& low, const std::string& high) {
   return low + "-" + high;
 }
 
+// A time per step: "4.73 ms", "652 ms", "2.16 s".
+std::string step_time_text(double seconds) {
+  char buf[32];
+  if (seconds < 1)
+    std::snprintf(buf, sizeof buf, "%.3g ms", 1e3 * seconds);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g s", seconds);
+  return buf;
+}
+
+// Hours as counted: "0.0232", "12.5", "16100".
+std::string hours_text(double h) {
+  char buf[32];
+  if (h >= 1000)
+    std::snprintf(buf, sizeof buf, "%.0f", std::round(h / 100) * 100);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g", h);
+  return buf;
+}
+
 std::string describe(const run::CaseSize& z, const json& key) {
   std::string d = z.scene;
   if (z.cells > 0)
@@ -121,33 +141,23 @@ int StepCost::threads() const {
 }
 
 std::string StepCost::basis() const {
-  char buf[256];
   std::string out;
-  if (measured && measured->steps > 0) {
-    std::snprintf(buf, sizeof buf,
-                  "measured here: %.3g ms per step alone (%d steps after a warm-up one), %d "
-                  "thread%s, setup %.2g s",
-                  1e3 * measured->step_s, measured->steps, measured->threads,
-                  measured->threads == 1 ? "" : "s", measured->setup_s);
-    out = buf;
-  }
-  if (measured_together && measured_together->steps > 0) {
-    std::snprintf(buf, sizeof buf,
-                  "; %.3g ms per step each with %d at once, as the workers will run",
-                  1e3 * measured_together->step_s, copies_together);
-    out += buf;
-  }
-  if (db_runs > 0) {
-    std::snprintf(
-        buf, sizeof buf,
-        "%s%d completed run%s in the database: %.3g ms per step (median, wall time over steps%s)",
-        out.empty() ? "" : "; used: ", db_runs, db_runs == 1 ? "" : "s", 1e3 * db_step_s,
-        db_threads > 0 ? (", " + std::to_string(db_threads) + " threads").c_str() : "");
-    out += buf;
-  }
-  return out.empty()
-             ? "no rate: not measured (--measure-steps 0) and no completed run of it in a database"
-             : out;
+  if (measured && measured->steps > 0)
+    out = "measured here: " + step_time_text(measured->step_s) + " per step alone (" +
+          std::to_string(measured->steps) + " steps after a warm-up one), " +
+          std::to_string(measured->threads) + " thread" + (measured->threads == 1 ? "" : "s") +
+          ", setup " + step_time_text(measured->setup_s);
+  if (measured_together && measured_together->steps > 0)
+    out += "; " + step_time_text(measured_together->step_s) + " per step each with " +
+           std::to_string(copies_together) + " at once, as the workers will run";
+  if (db_runs > 0)
+    out += (out.empty() ? "" : "; used: ") + std::to_string(db_runs) + " completed run" +
+           (db_runs == 1 ? "" : "s") + " in the database: " + step_time_text(db_step_s) +
+           " per step (median, wall time over steps" +
+           (db_threads > 0 ? ", " + std::to_string(db_threads) + " threads" : "") + ")";
+  return out.empty() ? "no rate: not measured (--measure-steps 0) and no completed run of it "
+                       "in a database"
+                     : out;
 }
 
 std::optional<double> slurm_time_limit_s(const std::string& limit) {
@@ -408,12 +418,9 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
     out << "total: "
         << range_text(number_text(p.lattice_updates_min), number_text(p.lattice_updates_max))
         << " lattice updates";
-    if (p.core_hours_min) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, ", %.3g-%.3g core-hours", *p.core_hours_min,
-                    *p.core_hours_max);
-      out << buf;
-    }
+    if (p.core_hours_min)
+      out << ", " << range_text(hours_text(*p.core_hours_min), hours_text(*p.core_hours_max))
+          << " core-hours (wall time x threads)";
     out << "\n";
     if (p.wall_min_s) {
       out << "estimated wall time: "

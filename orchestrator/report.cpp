@@ -10,6 +10,7 @@
 #include "engine/input/input_reader.hpp"
 #include "orchestrator/process.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -77,6 +78,7 @@ std::string value_text(const json& v) {
 
 struct Table {
   std::vector<std::string> columns;
+  std::vector<std::string> axes;                  // the sweeps' axes, in order
   std::vector<std::map<std::string, json>> rows;  // column -> value (null when absent)
 };
 
@@ -119,6 +121,21 @@ Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* c
         row[ob.name] = ob.mean;
         row[ob.name + "_err"] = ob.error ? json(*ob.error) : json();
       }
+      // short marks for the terminal table: s = a window still drifts, u = an
+      // error is not reliable (result.json's verdicts)
+      std::string flags;
+      if (!r.result_json.empty()) {
+        const json res = json::parse(r.result_json, nullptr, false);
+        if (res.is_object()) {
+          if (!res.value("not_stationary", json::array()).empty()) flags += "s";
+          const json measured = res.value("observables", json::object());
+          for (const auto& entry : measured.items())
+            if (entry.value().is_object() && !entry.value().value("error_reliable", true) &&
+                flags.find('u') == std::string::npos)
+              flags += "u";
+        }
+      }
+      row["flags"] = flags;
       row["wall_s"] = r.wall_s ? json(*r.wall_s) : json();
       row["mlups"] = r.mlups ? json(*r.mlups) : json();
       row["attempts"] = r.run.attempts;
@@ -128,6 +145,7 @@ Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* c
     }
   }
   for (const std::string& a : axes) t.columns.push_back(a);
+  t.axes = axes;
   for (const std::string& ob : observables) {
     t.columns.push_back(ob);
     t.columns.push_back(ob + "_err");
@@ -291,39 +309,52 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
     if (!(c.size() > 4 && c.compare(c.size() - 4, 4, "_err") == 0 &&
           std::find(cols.begin(), cols.end(), c.substr(0, c.size() - 4)) != cols.end()))
       shown.push_back(c);
-  std::vector<std::vector<std::string>> cells;
-  cells.push_back(shown);
-  for (std::size_t i : keep) {
-    std::vector<std::string> line;
-    for (const std::string& c : shown) {
+  bool any_flags = false;
+  for (std::size_t i : keep)
+    any_flags = any_flags || !t.rows[i]["flags"].get<std::string>().empty();
+  if (o.columns.empty()) {
+    // what a user reads first: the run, its state and point, the settling
+    // velocity, drag and aggregation, the flags; then the rest
+    static const std::vector<std::string> first{"U_over_Uinf", "F",  "n_a_mean",
+                                                "C_sph",       "Re", "Re_T"};
+    std::vector<std::string> ordered{"run", "status"};
+    auto take = [&](const std::string& c) {
+      if (std::find(shown.begin(), shown.end(), c) != shown.end() &&
+          std::find(ordered.begin(), ordered.end(), c) == ordered.end())
+        ordered.push_back(c);
+    };
+    for (const std::string& c : t.axes) take(c);
+    for (const std::string& c : first) take(c);
+    if (any_flags) ordered.push_back("flags");
+    for (const std::string& c : shown) take(c);
+    shown = ordered;
+  }
+  std::vector<TerminalColumn> table;
+  for (const std::string& c : shown) {
+    TerminalColumn col{c, {}};
+    for (std::size_t i : keep) {
       auto it = t.rows[i].find(c);
       std::string cell = it == t.rows[i].end() ? "" : value_text(it->second);
       auto e = t.rows[i].find(c + "_err");
       if (e != t.rows[i].end() && !e->second.is_null() && it != t.rows[i].end() &&
           it->second.is_number())
         cell = format_with_error(it->second.get<double>(), e->second.get<double>());
-      line.push_back(cell);
+      col.cells.push_back(cell);
     }
-    cells.push_back(line);
+    table.push_back(std::move(col));
   }
-  auto width = [](const std::string& s) {
-    std::size_t w = 0;
-    for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;  // count UTF-8 code points
-    return w;
-  };
-  std::vector<std::size_t> w(shown.size(), 0);
-  for (const auto& line : cells)
-    for (std::size_t c = 0; c < line.size(); ++c) w[c] = std::max(w[c], width(line[c]));
-  for (std::size_t r = 0; r < cells.size(); ++r) {
-    std::string line;
-    for (std::size_t c = 0; c < shown.size(); ++c) {
-      line += cells[r][c] + std::string(w[c] - width(cells[r][c]), ' ');
-      if (c + 1 < shown.size()) line += "  ";
-    }
-    line.erase(line.find_last_not_of(' ') + 1);
-    out << line << "\n";
-  }
+  const std::vector<std::string> left_out = write_fitted(table, o.width, out);
   out << "(" << keep.size() << " of " << t.rows.size() << " runs)\n";
+  if (any_flags && std::find(shown.begin(), shown.end(), "flags") != shown.end())
+    out << "flags: s = a window still drifts (not stationary), u = an error is not reliable "
+           "(`--format json` has the details)\n";
+  if (!left_out.empty()) {
+    std::string names;
+    for (const std::string& n : left_out) names += (names.empty() ? "" : ", ") + n;
+    out << left_out.size() << " more column" << (left_out.size() == 1 ? "" : "s") << " to fit "
+        << o.width << " characters: " << names << " (--all shows every column, --columns "
+        << "chooses; csv and json keep them all)\n";
+  }
   return static_cast<int>(keep.size());
 }
 

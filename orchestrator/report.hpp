@@ -38,8 +38,10 @@ struct QueryOptions {
   std::vector<Filter> where;
   std::string format = "table";  // table | csv | json
   // Only these columns (an observable brings its error along), in this order;
-  // empty: every column some row fills.
+  // empty: every column some row fills (the table: the first-read ones first).
   std::vector<std::string> columns;
+  // table: fit this many characters, leaving out the last columns (0: no limit)
+  std::size_t width = 0;
 };
 
 // Runs the query and writes it to `out`; returns the number of rows written.

@@ -85,8 +85,9 @@ TEST(SweepPlan, RefusesExactlyWhatTheRunRefusesWithItsMessage) {
     EXPECT_EQ(r.refused, run_says) << r.point.point.dump();
     const double re = r.point.case_json["Re_inf"];
     EXPECT_EQ(!r.refused.empty(), re == 48 || re == 72) << r.point.point.dump();
-    if (!r.refused.empty())
+    if (!r.refused.empty()) {
       EXPECT_THAT(r.refused, HasSubstr("raise numerics.a_over_dx to at least 6"));
+    }
   }
   std::ostringstream screen;
   orc::write_plan(plan, screen, false);
