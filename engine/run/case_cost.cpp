@@ -30,6 +30,23 @@ class ThreadsAsTheRun {
   int before_;
 };
 
+// After the setup: one untimed step (it touches every page and sizes each
+// stage's scratch), then at least `steps` steps and `seconds` seconds timed.
+// `advance` takes one step and says whether the state is still sound.
+template <class Advance>
+void time_steps(StepMeasurement& m, Advance&& advance, int steps, double seconds,
+                double memory_before) {
+  m.threads = omp_get_max_threads();
+  if (!advance()) return;
+  const auto t1 = TimedStages::Clock::now();
+  while ((m.steps < steps || TimedStages::since(t1) < seconds) && m.steps < kMostMeasuredSteps) {
+    if (!advance()) break;
+    ++m.steps;
+  }
+  if (m.steps > 0) m.step_s = TimedStages::since(t1) / m.steps;
+  m.memory_bytes = std::max(0.0, allocated_bytes() - memory_before);
+}
+
 template <class Real>
 StepMeasurement measure_sphere_steps(const cases::SuspensionCase& c, int steps, double seconds) {
   StepMeasurement m;
@@ -44,16 +61,8 @@ StepMeasurement measure_sphere_steps(const cases::SuspensionCase& c, int steps, 
   s.density_ratio = c.physics.density_ratio;
   place_spheres(c, modules, step.box(), s);
   m.setup_s = TimedStages::since(t0);
-  m.threads = omp_get_max_threads();
-  // the first step touches every page and sizes the scratch of each stage
-  if (!step.advance(s).empty()) return m;
-  const auto t1 = TimedStages::Clock::now();
-  while ((m.steps < steps || TimedStages::since(t1) < seconds) && m.steps < kMostMeasuredSteps) {
-    if (!step.advance(s).empty()) break;
-    ++m.steps;
-  }
-  if (m.steps > 0) m.step_s = TimedStages::since(t1) / m.steps;
-  m.memory_bytes = std::max(0.0, allocated_bytes() - memory_before);
+  time_steps(
+      m, [&] { return step.advance(s).empty(); }, steps, seconds, memory_before);
   return m;
 }
 
@@ -67,15 +76,13 @@ StepMeasurement measure_fluid_steps(const cases::FluidCase& c, int steps, double
   fluid.initialise_equilibrium(
       [&](int x, int y, int z) { return cases::initial_state(c, x, y, z); });
   m.setup_s = TimedStages::since(t0);
-  m.threads = omp_get_max_threads();
-  fluid.step();
-  const auto t1 = TimedStages::Clock::now();
-  while ((m.steps < steps || TimedStages::since(t1) < seconds) && m.steps < kMostMeasuredSteps) {
-    fluid.step();
-    ++m.steps;
-  }
-  if (m.steps > 0) m.step_s = TimedStages::since(t1) / m.steps;
-  m.memory_bytes = std::max(0.0, allocated_bytes() - memory_before);
+  time_steps(
+      m,
+      [&] {
+        fluid.step();
+        return true;
+      },
+      steps, seconds, memory_before);
   return m;
 }
 
