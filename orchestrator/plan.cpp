@@ -355,7 +355,7 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
                       z.cells > 0 ? std::to_string(z.box.nx) + "x" + std::to_string(z.box.ny) +
                                         "x" + std::to_string(z.box.nz)
                                   : "-",
-                      std::to_string(z.spheres),
+                      z.spheres > 0 ? std::to_string(z.spheres) : "-",
                       range_text(std::to_string(z.steps_min), std::to_string(z.steps_max)),
                       range_text(number_text(static_cast<double>(z.cells) * z.steps_min),
                                  number_text(static_cast<double>(z.cells) * z.steps_max)),
