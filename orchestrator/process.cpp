@@ -123,6 +123,24 @@ std::optional<db::Heartbeat> read_progress(const std::string& run_dir) {
   return hb;
 }
 
+RunStage read_run_stage(const std::string& run_dir) {
+  RunStage s;
+  std::ifstream f(run_dir + "/progress.json");
+  if (!f) return s;
+  try {
+    const nlohmann::json p = nlohmann::json::parse(f);
+    if (p.contains("stage") && p["stage"].is_string()) s.stage = p["stage"].get<std::string>();
+    if (p.contains("time") && p["time"].is_number()) s.time = p["time"].get<double>();
+    if (p.contains("time_total") && p["time_total"].is_number())
+      s.time_total = p["time_total"].get<double>();
+    if (p.contains("time_unit") && p["time_unit"].is_string())
+      s.time_unit = p["time_unit"].get<std::string>();
+  } catch (const std::exception&) {
+    // a file being replaced, or an older worker's: the stage is unknown
+  }
+  return s;
+}
+
 ResultRead read_result(const std::string& run_dir, const std::string& run_id) {
   const std::string file = run_dir + "/result.json";
   std::ifstream f(file);

@@ -30,6 +30,14 @@ pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file);
 
 // What progress.json says (the heartbeat); empty when absent or unreadable.
 std::optional<db::Heartbeat> read_progress(const std::string& run_dir);
+// Where a run stands in its own terms, from its progress.json: its stage and
+// simulated time (written by sphere scenes; empty fields otherwise).
+struct RunStage {
+  std::string stage;                       // "stage 1", "stage 2", "statistics"
+  std::optional<double> time, time_total;  // simulated time now and at the end
+  std::string time_unit;                   // "a/U_inf"
+};
+RunStage read_run_stage(const std::string& run_dir);
 
 // Parses DIR/result.json into a record for `run_id`. Returns the reason when
 // the file is missing, truncated, not JSON or not a completed result.

@@ -8,7 +8,9 @@
 #include <set>
 
 #include "engine/input/input_reader.hpp"
+#include "orchestrator/process.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -76,6 +78,7 @@ std::string value_text(const json& v) {
 
 struct Table {
   std::vector<std::string> columns;
+  std::vector<std::string> axes;                  // the sweeps' axes, in order
   std::vector<std::map<std::string, json>> rows;  // column -> value (null when absent)
 };
 
@@ -118,6 +121,21 @@ Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* c
         row[ob.name] = ob.mean;
         row[ob.name + "_err"] = ob.error ? json(*ob.error) : json();
       }
+      // short marks for the terminal table: s = a window still drifts, u = an
+      // error is not reliable (result.json's verdicts)
+      std::string flags;
+      if (!r.result_json.empty()) {
+        const json res = json::parse(r.result_json, nullptr, false);
+        if (res.is_object()) {
+          if (!res.value("not_stationary", json::array()).empty()) flags += "s";
+          const json measured = res.value("observables", json::object());
+          for (const auto& entry : measured.items())
+            if (entry.value().is_object() && !entry.value().value("error_reliable", true) &&
+                flags.find('u') == std::string::npos)
+              flags += "u";
+        }
+      }
+      row["flags"] = flags;
       row["wall_s"] = r.wall_s ? json(*r.wall_s) : json();
       row["mlups"] = r.mlups ? json(*r.mlups) : json();
       row["attempts"] = r.run.attempts;
@@ -127,6 +145,7 @@ Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* c
     }
   }
   for (const std::string& a : axes) t.columns.push_back(a);
+  t.axes = axes;
   for (const std::string& ob : observables) {
     t.columns.push_back(ob);
     t.columns.push_back(ob + "_err");
@@ -290,54 +309,67 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
     if (!(c.size() > 4 && c.compare(c.size() - 4, 4, "_err") == 0 &&
           std::find(cols.begin(), cols.end(), c.substr(0, c.size() - 4)) != cols.end()))
       shown.push_back(c);
-  std::vector<std::vector<std::string>> cells;
-  cells.push_back(shown);
-  for (std::size_t i : keep) {
-    std::vector<std::string> line;
-    for (const std::string& c : shown) {
+  bool any_flags = false;
+  for (std::size_t i : keep)
+    any_flags = any_flags || !t.rows[i]["flags"].get<std::string>().empty();
+  if (o.columns.empty()) {
+    // what a user reads first: the run, its state and point, the settling
+    // velocity, drag and aggregation, the flags; then the rest
+    static const std::vector<std::string> first{"U_over_Uinf", "F",  "n_a_mean",
+                                                "C_sph",       "Re", "Re_T"};
+    std::vector<std::string> ordered{"run", "status"};
+    auto take = [&](const std::string& c) {
+      if (std::find(shown.begin(), shown.end(), c) != shown.end() &&
+          std::find(ordered.begin(), ordered.end(), c) == ordered.end())
+        ordered.push_back(c);
+    };
+    for (const std::string& c : t.axes) take(c);
+    for (const std::string& c : first) take(c);
+    if (any_flags) ordered.push_back("flags");
+    for (const std::string& c : shown) take(c);
+    shown = ordered;
+  }
+  std::vector<TerminalColumn> table;
+  for (const std::string& c : shown) {
+    TerminalColumn col{c, {}};
+    for (std::size_t i : keep) {
       auto it = t.rows[i].find(c);
       std::string cell = it == t.rows[i].end() ? "" : value_text(it->second);
       auto e = t.rows[i].find(c + "_err");
       if (e != t.rows[i].end() && !e->second.is_null() && it != t.rows[i].end() &&
           it->second.is_number())
         cell = format_with_error(it->second.get<double>(), e->second.get<double>());
-      line.push_back(cell);
+      col.cells.push_back(cell);
     }
-    cells.push_back(line);
+    table.push_back(std::move(col));
   }
-  auto width = [](const std::string& s) {
-    std::size_t w = 0;
-    for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;  // count UTF-8 code points
-    return w;
-  };
-  std::vector<std::size_t> w(shown.size(), 0);
-  for (const auto& line : cells)
-    for (std::size_t c = 0; c < line.size(); ++c) w[c] = std::max(w[c], width(line[c]));
-  for (std::size_t r = 0; r < cells.size(); ++r) {
-    std::string line;
-    for (std::size_t c = 0; c < shown.size(); ++c) {
-      line += cells[r][c] + std::string(w[c] - width(cells[r][c]), ' ');
-      if (c + 1 < shown.size()) line += "  ";
-    }
-    line.erase(line.find_last_not_of(' ') + 1);
-    out << line << "\n";
-  }
+  const std::vector<std::string> left_out = write_fitted(table, o.width, out);
   out << "(" << keep.size() << " of " << t.rows.size() << " runs)\n";
+  if (any_flags && std::find(shown.begin(), shown.end(), "flags") != shown.end())
+    out << "flags: s = a window still drifts (not stationary), u = an error is not reliable "
+           "(`--format json` has the details)\n";
+  if (!left_out.empty()) {
+    std::string names;
+    for (const std::string& n : left_out) names += (names.empty() ? "" : ", ") + n;
+    out << left_out.size() << " more column" << (left_out.size() == 1 ? "" : "s") << " to fit "
+        << o.width << " characters: " << names << " (--all shows every column, --columns "
+        << "chooses; csv and json keep them all)\n";
+  }
   return static_cast<int>(keep.size());
 }
 
-namespace {
 std::string duration_text(double s) {
   char buf[64];
   if (s < 120)
     std::snprintf(buf, sizeof buf, "%.0f s", s);
   else if (s < 7200)
     std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
-  else
+  else if (s < 5 * 86400)
     std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f days", s / 86400);
   return buf;
 }
-}  // namespace
 
 std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_wall_s,
                                            const std::vector<RunningProgress>& running,
@@ -369,8 +401,42 @@ std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_
   return eta;
 }
 
-void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_name,
+namespace {
+
+// Columns padded to their widest cell, two spaces apart, indented.
+void write_columns(const std::vector<std::vector<std::string>>& rows, const std::string& indent,
+                   std::ostream& out) {
+  auto width = [](const std::string& s) {
+    std::size_t w = 0;
+    for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;
+    return w;
+  };
+  std::vector<std::size_t> w;
+  for (const auto& row : rows)
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      if (w.size() <= i) w.push_back(0);
+      w[i] = std::max(w[i], width(row[i]));
+    }
+  for (const auto& row : rows) {
+    std::string line = indent;
+    for (std::size_t i = 0; i < row.size(); ++i)
+      line += row[i] + (i + 1 < row.size() ? std::string(w[i] - width(row[i]) + 2, ' ') : "");
+    line.erase(line.find_last_not_of(' ') + 1);
+    out << line << "\n";
+  }
+}
+
+std::string first_line(const std::string& text, std::size_t most = 160) {
+  std::string line = text.substr(0, text.find('\n'));
+  if (line.size() > most) line = line.substr(0, most - 3) + "...";
+  return line;
+}
+
+}  // namespace
+
+bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_name,
                   std::ostream& out) {
+  bool active = false;
   std::vector<db::SweepRecord> sweeps;
   if (sweep_name) {
     auto s = db.find_sweep(*sweep_name);
@@ -385,11 +451,23 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
   for (db::AttemptRecord& a : db.live_attempts()) live[a.run_id] = a;
   for (const db::SweepRecord& s : sweeps) {
     const auto runs = db.runs(s.id);
-    out << "sweep " << s.name << ": " << runs.size() << " runs\n ";
-    for (const db::StateCount& c : db.count_states(s.id))
+    // lost and recovered: runs now lost, and completed runs that were lost before
+    int recovered = 0, lost_attempts = 0;
+    for (const db::RunRecord& r : runs) {
+      bool was_lost = false;
+      for (const db::AttemptRecord& a : db.attempts(r.id))
+        if (a.state == RunState::kLost) was_lost = true, ++lost_attempts;
+      if (was_lost && r.status == RunState::kCompleted) ++recovered;
+    }
+    out << "sweep " << s.name << ": " << runs.size() << " runs:";
+    int lost_now = 0;
+    for (const db::StateCount& c : db.count_states(s.id)) {
+      if (c.status == RunState::kLost) lost_now = c.runs;
       if (c.runs > 0 || c.status == RunState::kCompleted || c.status == RunState::kPending)
         out << " " << c.status << " " << c.runs;
-    out << "\n";
+    }
+    out << "; lost " << lost_now << " (" << lost_attempts << " attempt"
+        << (lost_attempts == 1 ? "" : "s") << " lost in all), recovered " << recovered << "\n";
     std::vector<double> completed_wall_s;
     int waiting = 0;
     for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
@@ -398,44 +476,79 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
           r.run.status == RunState::kLost)
         ++waiting;
     }
+    // Running runs: where each stands (stage and simulated time from its
+    // progress.json, which Slurm jobs write on the shared file system too).
     std::vector<RunningProgress> progress;
-    int running = 0;
-    bool header = false;
+    std::vector<std::vector<std::string>> table{
+        {"run", "point", "stage", "time", "done", "ETA", "MLUPS", "worker", "heartbeat"}};
     for (const db::RunRecord& r : runs) {
       auto it = live.find(r.id);
       if (it == live.end()) continue;
-      const db::AttemptRecord& a = it->second;
-      if (!header) {
-        out << "  running:\n";
-        header = true;
+      db::AttemptRecord a = it->second;
+      // the worker's own progress.json is fresher than the database's copy
+      // (written every few seconds by a local pool, by a Slurm task on its node)
+      if (const auto beat = read_progress(r.run_dir); beat && beat->at >= a.started_at) {
+        a.fraction = beat->fraction ? beat->fraction : a.fraction;
+        a.eta_s = beat->eta_s ? beat->eta_s : a.eta_s;
+        a.mlups = beat->mlups ? beat->mlups : a.mlups;
+        a.heartbeat_at = std::max(a.heartbeat_at.value_or(0), beat->at);
       }
-      ++running;
-      char line[512];
+      const RunStage stage = read_run_stage(r.run_dir);
+      char time[64] = "-", done[32], mlups[32] = "-";
+      if (stage.time && stage.time_total)
+        std::snprintf(time, sizeof time, "%.1f/%.0f %s", *stage.time, *stage.time_total,
+                      stage.time_unit.c_str());
+      else if (stage.time)
+        std::snprintf(time, sizeof time, "%.1f %s", *stage.time, stage.time_unit.c_str());
+      std::snprintf(done, sizeof done, "%.1f%%", 100 * a.fraction.value_or(0));
+      if (a.mlups) std::snprintf(mlups, sizeof mlups, "%.3g", *a.mlups);
       const double beat = a.heartbeat_at.value_or(a.started_at);
-      std::snprintf(line, sizeof line,
-                    "    %s  %-36s %5.1f%%  step %lld/%lld  %s MLUPS  ETA %s  %s pid %lld%s  "
-                    "heartbeat %s ago\n",
-                    r.id.substr(0, 12).c_str(), r.point_json.c_str(), 100 * a.fraction.value_or(0),
-                    static_cast<long long>(a.step.value_or(0)),
-                    static_cast<long long>(a.steps_total.value_or(0)),
-                    a.mlups ? format_number(*a.mlups).c_str() : "-",
-                    a.eta_s ? duration_text(*a.eta_s).c_str() : "?", a.host.c_str(),
-                    static_cast<long long>(a.pid),
-                    a.job_id.empty() ? "" : (" job " + a.job_id).c_str(),
-                    duration_text(now - beat).c_str());
-      out << line;
+      table.push_back(
+          {r.id.substr(0, 12), point_text(r.point_json), stage.stage.empty() ? "-" : stage.stage,
+           time, done, a.eta_s && *a.eta_s >= 0 ? duration_text(*a.eta_s) : "?", mlups,
+           a.host + " pid " + std::to_string(a.pid) + (a.job_id.empty() ? "" : " job " + a.job_id),
+           duration_text(now - beat) + " ago"});
       progress.push_back({a.fraction.value_or(0), a.eta_s});
     }
+    const int running = static_cast<int>(progress.size());
+    if (running > 0) {
+      out << "  running (" << running << "):\n";
+      write_columns(table, "    ", out);
+    }
+    // Runs that did not finish, with the first line of why and what to do.
+    std::vector<std::vector<std::string>> stopped;
+    bool retryable = false, exhausted_any = false, refused_any = false;
     for (const db::RunRecord& r : runs) {
       if (r.status != RunState::kFailed && r.status != RunState::kRefused &&
           r.status != RunState::kLost && r.status != RunState::kInterrupted)
         continue;
-      std::string err = r.error.substr(0, r.error.find('\n'));
-      if (err.size() > 160) err = err.substr(0, 157) + "...";
       const bool exhausted = r.status == RunState::kFailed && r.failures >= s.max_attempts;
-      out << "  " << r.status << " " << r.id.substr(0, 12) << " " << r.point_json << " (attempts "
-          << r.attempts << (exhausted ? ", retry limit reached" : "") << "): " << err << "\n";
+      if (r.status == RunState::kRefused)
+        refused_any = true;
+      else if (exhausted)
+        exhausted_any = true;
+      else
+        retryable = true;
+      stopped.push_back(
+          {to_string(r.status), r.id.substr(0, 12), point_text(r.point_json),
+           "attempts " + std::to_string(r.attempts) + (exhausted ? ", retry limit reached" : ""),
+           first_line(r.error)});
     }
+    if (!stopped.empty()) {
+      out << "  not finished (" << stopped.size() << "):\n";
+      write_columns(stopped, "    ", out);
+      if (retryable)
+        out << "    retry the failed, lost and interrupted runs (from their checkpoints): "
+            << "flocsim sweep resume --db " << db.path() << " --sweep " << s.name << "\n";
+      if (exhausted_any)
+        out << "    runs at the retry limit (max_attempts " << s.max_attempts
+            << ") are not retried: raise max_attempts in the sweep file and launch it again "
+               "(flocsim sweep launch SWEEP.json --db "
+            << db.path() << ")\n";
+      if (refused_any)
+        out << "    refused runs are not retried: change the case as the message says\n";
+    }
+    active = active || running > 0;
     if (running > 0 || waiting > 0) {
       const std::optional<SweepEta> eta = estimate_sweep_eta(completed_wall_s, progress, waiting);
       if (!eta) {
@@ -455,6 +568,7 @@ void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
       }
     }
   }
+  return active;
 }
 
 }  // namespace flocsim::orchestrator

@@ -30,13 +30,18 @@ bool filter_matches(const nlohmann::json& value, const Filter& filter);
 std::string format_with_error(double mean, std::optional<double> error,
                               const std::string& plus_minus = " ± ");
 
+// A duration as a user reads it: "45 s", "12.5 min", "3.2 h", "6.1 days".
+std::string duration_text(double seconds);
+
 struct QueryOptions {
   std::optional<std::string> sweep;  // restrict to one sweep
   std::vector<Filter> where;
   std::string format = "table";  // table | csv | json
   // Only these columns (an observable brings its error along), in this order;
-  // empty: every column some row fills.
+  // empty: every column some row fills (the table: the first-read ones first).
   std::vector<std::string> columns;
+  // table: fit this many characters, leaving out the last columns (0: no limit)
+  std::size_t width = 0;
 };
 
 // Runs the query and writes it to `out`; returns the number of rows written.
@@ -64,7 +69,10 @@ std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_
                                            const std::vector<RunningProgress>& running,
                                            int waiting);
 
-// Counts by state, the running runs with progress and ETA, the failures.
-void write_status(db::ResultsDb& db, const std::optional<std::string>& sweep, std::ostream& out);
+// Counts by state (lost and recovered runs too); each running run's stage,
+// simulated time, share done and ETA (from its progress.json); the runs that
+// did not finish with the first line of why and the command that retries
+// them; the sweep's ETA. True while a run of the sweep(s) is running.
+bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep, std::ostream& out);
 
 }  // namespace flocsim::orchestrator

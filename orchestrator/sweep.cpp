@@ -293,4 +293,15 @@ std::vector<RunPoint> expand(const SweepSpec& sweep) {
   }
 }
 
+std::string point_text(const std::string& point_json) {
+  if (point_json.empty()) return "";
+  const auto p = nlohmann::ordered_json::parse(point_json, nullptr, false);
+  if (!p.is_object()) return point_json;
+  std::string out;
+  for (auto it = p.begin(); it != p.end(); ++it)
+    out += (out.empty() ? "" : " ") + it.key() + "=" +
+           (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
+  return out;
+}
+
 }  // namespace flocsim::orchestrator

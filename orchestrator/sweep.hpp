@@ -76,4 +76,8 @@ std::vector<RunPoint> expand(const SweepSpec& sweep);
 
 inline constexpr std::size_t kMaxRunsPerSweep = 100000;
 
+// A grid point as a user reads it: "Re_inf=6 du_over_Uinf=0.03" (its JSON text
+// when it is not an object).
+std::string point_text(const std::string& point_json);
+
 }  // namespace flocsim::orchestrator

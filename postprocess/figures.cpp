@@ -1,5 +1,6 @@
 #include "postprocess/figures.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,15 @@ class Plot {
     return "'" + p.string() + "'";
   }
   std::ostringstream& commands() { return commands_; }
+  // Records a run whose data the figure draws (each once, in order).
+  void uses(const RunSummary* r) {
+    if (r && std::find(runs_.begin(), runs_.end(), r->id) == runs_.end()) runs_.push_back(r->id);
+  }
+  // The rendered figure with the runs it drew.
+  Figure with_runs(Figure f) const {
+    f.runs = runs_;
+    return f;
+  }
   // Renders PNG and PDF with the same commands.
   Figure render(const std::string& size_png = "900,650",
                 const std::string& size_pdf = "6in,4.3in") {
@@ -73,6 +83,7 @@ class Plot {
   fs::path dir_;
   std::string name_, caption_;
   std::ostringstream commands_;
+  std::vector<std::string> runs_;
 };
 
 // A run's series.h5, read once; empty when the run has none.
@@ -139,6 +150,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       std::ostringstream rows, wylie;
       for (const RunSummary* r : done)
         if (r->phi == phi && r->du == 0) {
+          p.uses(r);
           rows << num(r->Re->mean) << " " << num(r->F->mean) << " " << num(r->F->error.value_or(0))
                << "\n";
           wylie << num(r->Re->mean) << " "
@@ -163,7 +175,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
     } else {
       p.commands() << "set xlabel 'Re'\nset ylabel 'F'\nset key left top\nset grid\nset xrange [0:"
                    << num(1.15 * re_max) << "]\nset samples 200\nplot " << plots << "\n";
-      set.figures.push_back(p.render());
+      set.figures.push_back(p.with_runs(p.render()));
     }
   }
 
@@ -175,9 +187,11 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
     for (double phi : phis) {
       std::ostringstream rows;
       for (const RunSummary* r : done)
-        if (r->phi == phi && r->du == 0 && r->Re_T)
+        if (r->phi == phi && r->du == 0 && r->Re_T) {
+          p.uses(r);
           rows << num(r->Re->mean) << " " << num(r->Re_T->mean) << " "
                << num(r->Re_T->error.value_or(0)) << "\n";
+        }
       if (rows.str().empty()) continue;
       plots += (plots.empty() ? "" : ", ") + p.data("phi" + num(phi), rows.str()) + " " + kPoint +
                " title 'phi = " + num(phi) + "'";
@@ -187,7 +201,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
     } else {
       p.commands() << "set xlabel 'Re'\nset ylabel 'Re_T'\nset grid\nset key left top\nplot "
                    << plots << "\n";
-      set.figures.push_back(p.render());
+      set.figures.push_back(p.with_runs(p.render()));
     }
   }
 
@@ -211,6 +225,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                  "well is switched on (Figs. 5, 7)");
       std::string top, bottom;
       for (const auto& [r, s] : members) {
+        p.uses(r);
         // without a well there is no switch: its statistics start where stage 1
         // was found stationary, the moment the others switch the well on
         double t0 = r->window_end > r->window_start ? r->window_start : s.time.front();
@@ -232,7 +247,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       p.commands() << "set multiplot layout 2,1\nset grid\nset xlabel 't U_{inf} / a'\nset ylabel "
                       "'U/U_{inf}'\nset key left top\nplot "
                    << top << "\nset ylabel 'C_{sph}'\nplot " << bottom << "\nunset multiplot\n";
-      set.figures.push_back(p.render("900,800", "6in,5.4in"));
+      set.figures.push_back(p.with_runs(p.render("900,800", "6in,5.4in")));
     }
     // mass-weighted p(n_a) on log axes
     {
@@ -245,6 +260,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
         for (std::size_t n = 1; n < s.size_distribution.size(); ++n)
           if (s.size_distribution[n] > 0) rows << n << " " << num(s.size_distribution[n]) << "\n";
         if (rows.str().empty()) continue;
+        p.uses(r);
         plots += (plots.empty() ? "" : ", ") +
                  p.data("du" + num(r->du) + "_" + r->id.substr(0, 8), rows.str()) +
                  " with linespoints pt 7 title 'du/U_{inf} = " + num(r->du) + "'";
@@ -252,7 +268,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       if (!plots.empty()) {
         p.commands() << "set logscale xy\nset grid\nset xlabel 'n_a'\nset ylabel 'p(n_a)'\nplot "
                      << plots << "\n";
-        set.figures.push_back(p.render());
+        set.figures.push_back(p.with_runs(p.render()));
       }
     }
     // g(r) and h(theta)
@@ -264,6 +280,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       std::string top, bottom;
       for (const auto& [r, s] : members) {
         if (s.g.empty() || s.h.empty()) continue;
+        p.uses(r);
         std::ostringstream g, h;
         for (std::size_t k = 0; k < s.g.size() && k < s.r_over_a.size(); ++k)
           g << num(s.r_over_a[k]) << " " << num(s.g[k]) << "\n";
@@ -284,7 +301,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
             << "\nset xlabel 'theta (rad)'\nset ylabel 'h(theta)'\nset xrange [0:pi]\n"
                "plot "
             << bottom << "\nunset multiplot\n";
-        set.figures.push_back(p.render("900,800", "6in,5.4in"));
+        set.figures.push_back(p.with_runs(p.render("900,800", "6in,5.4in")));
       }
     }
     // space-time maps of phi(x, t) - phi, one per run
@@ -293,6 +310,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       Plot p(dir, "spacetime_" + tag + "_du" + num(r->du),
              "Space-time map of the slab solids fraction phi(x, t) - phi at phi = " + num(phi) +
                  ", Re_inf = " + num(re_inf) + ", du/U_inf = " + num(r->du) + " (Figs. 3, 13)");
+      p.uses(r);
       std::ostringstream rows;
       const std::size_t samples = s.phi_x.size() / s.slabs;
       for (std::size_t k = 0; k < samples && k < s.time.size(); ++k) {
@@ -311,7 +329,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
           << " using 3 nooutput\nm = abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : "
              "abs(STATS_max)\nset cbrange [-m:m]\nset autoscale xfix\nset autoscale yfix\nplot "
           << file << " using 1:2:3 with image notitle\n";
-      set.figures.push_back(p.render());
+      set.figures.push_back(p.with_runs(p.render()));
     }
   }
 
@@ -325,9 +343,11 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       for (double re : res) {
         std::ostringstream rows;
         for (const RunSummary* r : done)
-          if (r->phi == phi && r->re_inf == re && r->n_a)
+          if (r->phi == phi && r->re_inf == re && r->n_a) {
+            p.uses(r);
             rows << num(r->du) << " " << num(r->n_a->mean) << " " << num(r->n_a->error.value_or(0))
                  << "\n";
+          }
         if (rows.str().empty()) continue;
         plots += (plots.empty() ? "" : ", ") + p.data(label(phi, re), rows.str()) + " " + kPoint +
                  " title 'phi = " + num(phi) + ", Re_{inf} = " + num(re) + "'";
@@ -346,7 +366,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       p.commands() << "set xlabel 'du/U_{inf}'\nset ylabel '<n_a>'\nset logscale y\nset grid\nset "
                       "key left top\nplot "
                    << plots << "\n";
-      set.figures.push_back(p.render());
+      set.figures.push_back(p.with_runs(p.render()));
     }
   }
   {
@@ -356,9 +376,11 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
     for (double du : dus) {
       std::ostringstream rows;
       for (const RunSummary* r : done)
-        if (r->du == du)
+        if (r->du == du) {
+          p.uses(r);
           rows << num(r->Re->mean) << " " << num(r->F->mean) << " " << num(r->F->error.value_or(0))
                << "\n";
+        }
       plots += (plots.empty() ? "" : ", ") + p.data("du" + num(du), rows.str()) +
                " with yerrorbars pt " + std::to_string(style++) +
                " ps 1.3 title 'du/U_{inf} = " + num(du) + "'";
@@ -368,7 +390,7 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
     } else {
       p.commands() << "set xlabel 'Re'\nset ylabel 'F'\nset grid\nset key right top\nplot " << plots
                    << "\n";
-      set.figures.push_back(p.render());
+      set.figures.push_back(p.with_runs(p.render()));
     }
   }
   {
@@ -396,10 +418,15 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
                    " ps 1.3 title 'Re_{inf} = " + num(re) + "'";
         p.commands() << "set title 'phi = " << num(phi) << "'\nplot " << plots << "\n";
       }
+      for (const AggregationRow& a : agg)
+        if (a.F_over_F0 && a.n_over_n0) {
+          p.uses(a.run);
+          p.uses(a.baseline);
+        }
       p.commands() << "unset multiplot\n";
       const int width = 450 * static_cast<int>(by_phi.size()) + 150;
       set.figures.push_back(
-          p.render(std::to_string(width) + ",550", num(width / 150.0) + "in,3.7in"));
+          p.with_runs(p.render(std::to_string(width) + ",550", num(width / 150.0) + "in,3.7in")));
     }
   }
   return set;

@@ -17,6 +17,7 @@ struct Figure {
   std::string name;     // file stem, e.g. "drag_vs_Re"
   std::string caption;  // what it shows, as in the paper
   std::filesystem::path png, pdf;
+  std::vector<std::string> runs;  // ids of the runs whose data it draws
 };
 
 struct FigureSet {

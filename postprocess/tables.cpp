@@ -1,15 +1,18 @@
 #include "postprocess/tables.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/observables/reference_correlations.hpp"
 #include "engine/result_names/result_names.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 #include "postprocess/paper_values.hpp"
 
 namespace flocsim::postprocess {
@@ -214,6 +217,9 @@ struct Writer {
   std::string format;
   std::ostream& out;
   std::vector<std::string> cells;
+  // when set, rows (header first) are collected here as Markdown would show
+  // their cells, instead of being written
+  std::vector<std::vector<std::string>>* grid = nullptr;
 
   static std::string number(double v) {
     char b[40];
@@ -242,10 +248,11 @@ struct Writer {
       cells.push_back(names[i]);
       if (format == "csv" && with_error[i]) cells.push_back(names[i] + "_err");
     }
-    if (format == "tex") {
+    if (format == "tex" && !grid) {
       out << "\\begin{tabular}{" << std::string(cells.size(), 'l') << "}\n\\toprule\n";
     }
     end_row();
+    if (grid) return;
     if (format == "md") {
       out << "|";
       for (std::size_t i = 0; i < names.size(); ++i) out << "---|";
@@ -254,6 +261,11 @@ struct Writer {
     if (format == "tex") out << "\\midrule\n";
   }
   void end_row() {
+    if (grid) {
+      grid->push_back(cells);
+      cells.clear();
+      return;
+    }
     for (std::size_t i = 0; i < cells.size(); ++i) {
       std::string c = cells[i];
       if (format == "csv" && c.find_first_of(",\"\n") != std::string::npos) {
@@ -282,7 +294,7 @@ struct Writer {
     cells.clear();
   }
   void finish() {
-    if (format == "tex") out << "\\bottomrule\n\\end{tabular}\n";
+    if (format == "tex" && !grid) out << "\\bottomrule\n\\end{tabular}\n";
   }
 };
 
@@ -328,9 +340,9 @@ std::string window_text(const RunSummary& r) {
 
 }  // namespace
 
-void write_aggregation(const std::vector<AggregationRow>& rows, const std::string& format,
-                       std::ostream& out) {
-  Writer w{format, out, {}};
+namespace {
+
+void fill_aggregation(Writer& w, const std::vector<AggregationRow>& rows) {
   w.header({"phi",
             "Re_inf",
             "du_over_Uinf",
@@ -392,9 +404,7 @@ void write_aggregation(const std::vector<AggregationRow>& rows, const std::strin
   w.finish();
 }
 
-void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std::string& format,
-                           std::ostream& out) {
-  Writer w{format, out, {}};
+void fill_non_aggregating(Writer& w, const std::vector<NonAggregatingRow>& rows) {
   w.header({"phi", "Re_inf", "Re", "F", "Re_T", "F_Beetstra", "dev_Beetstra_pct", "F_Wylie",
             "dev_Wylie_pct", "U_over_Uinf", "U_over_Uinf_RZ", "dev_RZ_pct", "window", "N",
             "errors_reliable", "stationary", "run"},
@@ -425,6 +435,171 @@ void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std
     w.end_row();
   }
   w.finish();
+}
+
+}  // namespace
+
+void write_aggregation(const std::vector<AggregationRow>& rows, const std::string& format,
+                       std::ostream& out) {
+  Writer w{format, out, {}};
+  fill_aggregation(w, rows);
+}
+
+void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std::string& format,
+                           std::ostream& out) {
+  Writer w{format, out, {}};
+  fill_non_aggregating(w, rows);
+}
+
+std::vector<std::vector<std::string>> aggregation_cells(const std::vector<AggregationRow>& rows) {
+  std::ostringstream unused;
+  std::vector<std::vector<std::string>> grid;
+  Writer w{"md", unused, {}, &grid};
+  fill_aggregation(w, rows);
+  return grid;
+}
+
+std::vector<std::vector<std::string>> non_aggregating_cells(
+    const std::vector<NonAggregatingRow>& rows) {
+  std::ostringstream unused;
+  std::vector<std::vector<std::string>> grid;
+  Writer w{"md", unused, {}, &grid};
+  fill_non_aggregating(w, rows);
+  return grid;
+}
+
+RowFlags run_flags(const RunSummary& r, const RunSummary* baseline) {
+  RowFlags f;
+  if (!r.has_result) return f;
+  const bool reliable = r.errors_reliable && (!baseline || baseline->errors_reliable);
+  if (!reliable) {
+    f.marks += "u";
+    f.detail += "u: errors not reliable (fewer than 5 batches of at least 5 correlation times";
+    f.detail += baseline ? ", in this run or its baseline)" : ")";
+  }
+  std::string drifting;
+  if (!r.not_stationary.empty()) drifting = stationary_text(r).substr(4);
+  if (baseline && !baseline->not_stationary.empty())
+    drifting += (drifting.empty() ? "" : "; ") + std::string("baseline:") +
+                stationary_text(*baseline).substr(3);
+  if (!drifting.empty()) {
+    f.marks += "s";
+    f.detail += std::string(f.detail.empty() ? "" : "\n") + "s: not stationary: " + drifting;
+  }
+  return f;
+}
+
+RowFlags aggregation_flags(const AggregationRow& row) {
+  RowFlags f = run_flags(*row.run, row.baseline);
+  if (!row.reason.empty()) {
+    f.marks += "b";
+    f.detail += std::string(f.detail.empty() ? "" : "\n") + "b: no F/F0: " + row.reason;
+  }
+  return f;
+}
+
+std::string column_label(const std::string& name, bool html) {
+  struct Label {
+    const char *name, *text, *html;
+  };
+  static const Label labels[] = {
+      {"phi", "phi", "&phi;"},
+      {"Re_inf", "Re_inf", "Re<sub>&infin;</sub>"},
+      {"du_over_Uinf", "du/U_inf", "du/U<sub>&infin;</sub>"},
+      {"Re", "Re", "Re"},
+      {"F", "F", "F"},
+      {"F0", "F0", "F<sub>0</sub>"},
+      {"F_over_F0", "F/F0", "F/F<sub>0</sub>"},
+      {"n_a", "<n_a>", "&lang;n<sub>a</sub>&rang;"},
+      {"n_a0", "<n_a>0", "&lang;n<sub>a</sub>&rang;<sub>0</sub>"},
+      {"n_a_over_n_a0", "<n_a>/<n_a>0",
+       "&lang;n<sub>a</sub>&rang;/&lang;n<sub>a</sub>&rang;<sub>0</sub>"},
+      {"n_a_paper", "<n_a> paper", "&lang;n<sub>a</sub>&rang; paper"},
+      {"n_a_over_paper", "<n_a>/paper", "&lang;n<sub>a</sub>&rang; / paper"},
+      {"n_a_over_n_a0_paper", "<n_a>/<n_a>0 paper",
+       "&lang;n<sub>a</sub>&rang;/&lang;n<sub>a</sub>&rang;<sub>0</sub> paper"},
+      {"U_over_Uinf", "U/U_inf", "U/U<sub>&infin;</sub>"},
+      {"C_sph", "C_sph", "C<sub>sph</sub>"},
+      {"Re_T", "Re_T", "Re<sub>T</sub>"},
+      {"window", "window (a/U_inf)", "window (a/U<sub>&infin;</sub>)"},
+      {"N", "N", "N"},
+      {"errors_reliable", "errors reliable", "errors reliable"},
+      {"stationary", "stationary", "stationary"},
+      {"run", "run", "run"},
+      {"baseline", "baseline", "baseline"},
+      {"note", "note", "note"},
+      {"F_Beetstra", "F Beetstra", "F<sub>Beetstra</sub>"},
+      {"dev_Beetstra_pct", "F/F_Beetstra - 1 (%)", "F/F<sub>Beetstra</sub> &minus; 1 (%)"},
+      {"F_Wylie", "F Wylie", "F<sub>Wylie</sub>"},
+      {"dev_Wylie_pct", "F/F_Wylie - 1 (%)", "F/F<sub>Wylie</sub> &minus; 1 (%)"},
+      {"U_over_Uinf_RZ", "U/U_inf R-Z", "U/U<sub>&infin;</sub> R&ndash;Z"},
+      {"dev_RZ_pct", "U/U_RZ - 1 (%)", "U/U<sub>RZ</sub> &minus; 1 (%)"},
+      {"flags", "flags", "flags"},
+  };
+  for (const Label& l : labels)
+    if (name == l.name) return html ? l.html : l.text;
+  return name;
+}
+
+const std::vector<std::string>& aggregation_first_columns() {
+  static const std::vector<std::string> first{"phi",       "Re_inf",        "du_over_Uinf",
+                                              "F_over_F0", "n_a_over_n_a0", "U_over_Uinf"};
+  return first;
+}
+
+void write_aggregation_terminal(const std::vector<AggregationRow>& rows,
+                                const std::vector<std::string>& columns, bool all,
+                                std::size_t width, std::ostream& out) {
+  const auto grid = aggregation_cells(rows);
+  const std::vector<std::string>& names = grid.front();
+  std::vector<std::string> wanted = columns;
+  if (all) wanted = names;
+  if (wanted.empty()) wanted = aggregation_first_columns();
+  std::vector<orchestrator::TerminalColumn> table;
+  for (const std::string& name : wanted) {
+    if (name == "flags") continue;
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      std::string known;
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw input::InputError("--columns " + name + ": no such column (columns: " + known +
+                              ", flags)");
+    }
+    const std::size_t c = static_cast<std::size_t>(it - names.begin());
+    orchestrator::TerminalColumn col{column_label(name, false), {}};
+    for (std::size_t r = 1; r < grid.size(); ++r) col.cells.push_back(grid[r][c]);
+    table.push_back(std::move(col));
+  }
+  // the flags follow the first columns (they stand for the verdict columns)
+  orchestrator::TerminalColumn flags{"flags", {}};
+  std::string seen;
+  for (const AggregationRow& row : rows) {
+    flags.cells.push_back(aggregation_flags(row).marks);
+    for (char m : flags.cells.back())
+      if (seen.find(m) == std::string::npos) seen += m;
+  }
+  // by default only where a row has a mark; always when asked for
+  const bool show_flags = (columns.empty() && !seen.empty()) ||
+                          std::find(columns.begin(), columns.end(), "flags") != columns.end();
+  if (show_flags) {
+    // right after the first-read columns, so that fitting never drops it first
+    const std::size_t at = std::min(table.size(), aggregation_first_columns().size());
+    table.insert(table.begin() + static_cast<long>(columns.empty() ? at : table.size()), flags);
+  }
+  const std::vector<std::string> left_out = orchestrator::write_fitted(table, width, out);
+  if (show_flags && !seen.empty()) {
+    out << "flags:";
+    if (seen.find('u') != std::string::npos) out << " u = errors not reliable;";
+    if (seen.find('s') != std::string::npos) out << " s = a window still drifts;";
+    if (seen.find('b') != std::string::npos) out << " b = no F/F0 (the note column says why);";
+    out << " details in aggregation.md\n";
+  }
+  if (!left_out.empty()) {
+    std::string n;
+    for (const auto& h : left_out) n += (n.empty() ? "" : ", ") + h;
+    out << left_out.size() << " column" << (left_out.size() == 1 ? "" : "s") << " left out to fit "
+        << width << " characters: " << n << "\n";
+  }
 }
 
 std::string column_definitions() {

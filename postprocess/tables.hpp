@@ -88,4 +88,34 @@ void write_non_aggregating(const std::vector<NonAggregatingRow>& rows, const std
 // Definitions and units of every column (the CSV files' sidecar).
 std::string column_definitions();
 
+// The tables' cells as Markdown shows them (means rounded to their errors), one
+// vector per row, the column names first: for the terminal and the HTML page.
+std::vector<std::vector<std::string>> aggregation_cells(const std::vector<AggregationRow>& rows);
+std::vector<std::vector<std::string>> non_aggregating_cells(
+    const std::vector<NonAggregatingRow>& rows);
+
+// A column as the quantity reads: "F/F0", "<n_a>/<n_a>0", "du/U_inf" in plain
+// text; in HTML with sub- and superscripts and entities. Unknown names as given.
+std::string column_label(const std::string& name, bool html);
+
+// Short marks for a row, with their details: u = errors not reliable, s = a
+// window still drifts (not stationary), b = no F/F0 (the reason).
+struct RowFlags {
+  std::string marks;   // "", "u", "us", ...
+  std::string detail;  // one line per mark
+};
+RowFlags run_flags(const RunSummary& run, const RunSummary* baseline = nullptr);
+RowFlags aggregation_flags(const AggregationRow& row);
+
+// The columns a user reads first: phi, Re_inf, du/U_inf, F/F0, <n_a>/<n_a>0, U/U_inf.
+const std::vector<std::string>& aggregation_first_columns();
+
+// The aggregation table for a terminal: the first columns and the flags, or
+// `columns` (names as in the files, "flags" too), or every column (`all`),
+// fitted to `width` characters (0: no limit), then the flags' legend and the
+// columns left out. Throws input::InputError for an unknown column.
+void write_aggregation_terminal(const std::vector<AggregationRow>& rows,
+                                const std::vector<std::string>& columns, bool all,
+                                std::size_t width, std::ostream& out);
+
 }  // namespace flocsim::postprocess

@@ -9,6 +9,7 @@
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
 #include "engine/input/input_reader.hpp"
+#include "orchestrator/terminal_table.hpp"
 #include "postprocess/figures.hpp"
 #include "postprocess/report.hpp"
 #include "postprocess/tables.hpp"
@@ -21,7 +22,8 @@ namespace pp = flocsim::postprocess;
 
 struct PostOptions {
   std::string db_path, out_dir, sweep;
-  std::vector<std::string> where;
+  std::vector<std::string> where, columns;
+  bool all = false;
 };
 
 void write_file(const fs::path& p, const std::string& text) {
@@ -30,8 +32,10 @@ void write_file(const fs::path& p, const std::string& text) {
   if (!f) throw std::runtime_error("cannot write " + p.string());
 }
 
-// Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table.
-void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out) {
+// Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table:
+// the columns a user reads first, fitted to the terminal (the files keep all).
+void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out,
+                  const PostOptions& o) {
   const auto agg = pp::aggregation_table(runs);
   const auto non = pp::non_aggregating_table(runs);
   for (const std::string format : {"csv", "md", "tex"}) {
@@ -42,10 +46,13 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out) 
     write_file(out / ("non_aggregating." + format), n.str());
   }
   write_file(out / "columns.md", pp::column_definitions());
-  std::ostringstream shown;
-  pp::write_aggregation(agg, "md", shown);
-  std::cout << "Aggregation: F/F0 against <n_a>/<n_a>0 (" << agg.size() << " runs with du > 0)\n\n"
-            << shown.str() << "\nNon-aggregating runs against Beetstra, Wylie and "
+  std::cout << "Aggregation: F/F0 against <n_a>/<n_a>0 (" << agg.size()
+            << " runs with du > 0; every column in " << (out / "aggregation.md").string()
+            << ")\n\n";
+  pp::write_aggregation_terminal(agg, o.columns, o.all,
+                                 o.all || !o.columns.empty() ? 0 : orchestrator::terminal_width(),
+                                 std::cout);
+  std::cout << "\nNon-aggregating runs against Beetstra, Wylie and "
             << "Richardson-Zaki: " << non.size() << " rows in "
             << (out / "non_aggregating.md").string()
             << "\nTables (CSV, Markdown, LaTeX) and their column definitions (columns.md) in "
@@ -62,14 +69,14 @@ int post(const std::string& what, const PostOptions& o) {
     const fs::path out(o.out_dir);
     fs::create_directories(out);
     if (what == "tables") {
-      write_tables(runs, out);
+      write_tables(runs, out, o);
     } else {
       const pp::FigureSet figures = pp::write_figures(runs, out / "figures");
       if (what == "figures")
         for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
       for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
       if (what == "report") {
-        write_tables(runs, out);
+        write_tables(runs, out, o);
         pp::write_report(runs, figures, o.db_path, out / "report.html");
       }
       std::cout << figures.figures.size() << " figures (PNG and PDF, with their data and gnuplot "
@@ -110,6 +117,13 @@ const bool registered = register_command(
          sub->add_option("--sweep", o->sweep, "Only the runs of this sweep");
          sub->add_option("--where,-w", o->where, "Filter FIELD OP VALUE, as in flocsim query")
              ->take_all();
+         if (name != "figures") {
+           sub->add_option("--columns,-c", o->columns,
+                           "The printed table's columns, by their names in the files (and "
+                           "flags), e.g. phi,du_over_Uinf,F,F0,F_over_F0")
+               ->delimiter(',');
+           sub->add_flag("--all", o->all, "Print every column, however wide");
+         }
          sub->callback([what, name = name] { *what = name; });
        }
        return CommandHandler([o, what] { return post(*what, *o); });

@@ -7,6 +7,7 @@
 #include "db/results_db.hpp"
 #include "engine/input/input_reader.hpp"
 #include "orchestrator/report.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::app {
 namespace {
@@ -19,6 +20,7 @@ const bool registered = register_command(
        struct Options {
          std::string db_path, sweep, format = "table";
          std::vector<std::string> where, columns;
+         bool all = false;
        };
        auto o = std::make_shared<Options>();
        cmd.add_option("--db", o->db_path, "Results database")->required();
@@ -31,6 +33,8 @@ const bool registered = register_command(
                       "Only these columns, in this order (comma-separated or repeated), e.g. "
                       "phi,du_over_Uinf,U_over_Uinf,F")
            ->delimiter(',');
+       cmd.add_flag("--all", o->all,
+                    "Every column, however wide (the table otherwise fits the terminal)");
        cmd.add_option("--format,-f", o->format, "Output format")
            ->check(CLI::IsMember({"table", "csv", "json"}));
        return CommandHandler([o]() -> int {
@@ -39,6 +43,8 @@ const bool registered = register_command(
            if (!o->sweep.empty()) q.sweep = o->sweep;
            q.format = o->format;
            q.columns = o->columns;
+           // a chosen set of columns, or --all, is shown whole
+           q.width = o->all || !o->columns.empty() ? 0 : orc::terminal_width();
            for (const std::string& w : o->where) q.where.push_back(orc::parse_filter(w));
            db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kReadOnly);  // only reads
            orc::write_query(db, q, std::cout);

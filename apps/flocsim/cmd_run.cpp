@@ -5,9 +5,7 @@
 #include <cstdio>
 
 #include "apps/flocsim/command_registry.hpp"
-#include "engine/case/fluid_case.hpp"
-#include "engine/case/scene.hpp"
-#include "engine/case/suspension_case.hpp"
+#include "engine/case/case_file.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/fluid_run.hpp"
@@ -26,17 +24,9 @@ struct RunArguments {
 
 int run_command(const RunArguments& a) {
   // Read and validate the whole case before any work starts.
-  cases::FluidCase fluid_case;
-  cases::SuspensionCase sphere_case;
-  bool fluid_scene = false;
+  cases::ParsedCase parsed;
   try {
-    const nlohmann::json document = input::read_json_file(a.case_file);
-    // the scene decides which parser and which time loop take the case
-    fluid_scene = !cases::modules_of(cases::scene_of(document)).spheres;
-    if (fluid_scene)
-      fluid_case = cases::parse_fluid_case(document);
-    else
-      sphere_case = cases::parse_suspension_case(document);
+    parsed = cases::parse_case(input::read_json_file(a.case_file));
   } catch (const input::InputError& e) {
     // file-level refusals (read_json_file) already start with the file's name
     const std::string what = e.what();
@@ -53,8 +43,8 @@ int run_command(const RunArguments& a) {
   options.stop_after_steps = a.stop_after_steps;
   run::RunReport report;
   try {
-    report = fluid_scene ? run::run_fluid_case(fluid_case, options)
-                         : run::run_sphere_case(sphere_case, options);
+    report = parsed.fluid_scene ? run::run_fluid_case(parsed.fluid, options)
+                                : run::run_sphere_case(parsed.spheres, options);
   } catch (const input::InputError& e) {
     std::fprintf(stderr, "flocsim run: input error: %s\n", e.what());
     return kExitBadInput;

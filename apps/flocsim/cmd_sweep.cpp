@@ -4,16 +4,19 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <sstream>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
+#include "orchestrator/plan.hpp"
 #include "orchestrator/process.hpp"
 #include "orchestrator/report.hpp"
 #include "orchestrator/slurm_backend.hpp"
@@ -31,6 +34,9 @@ struct SweepOptions {
   double lease_s = 60;
   double grace_s = 120;
   bool no_wait = false;
+  int measure_steps = 3;
+  double watch_s = 0;
+  std::string plan_db;
   // slurm-task (internal)
   std::string task_file;
 };
@@ -112,6 +118,37 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
   return exit_code_for(db, sweep, s.stopped);
 }
 
+// `status --watch`: the status again every `every_s` seconds, in place on a
+// terminal (one frame after another otherwise), until nothing of the sweep
+// runs (two frames in a row), or Ctrl-C.
+int watch_status(db::ResultsDb& db, bool writable, const std::optional<std::string>& sweep,
+                 double every_s, double lease_s) {
+  process::install_stop_handlers(process::SecondSignal::ends_the_process);
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  int idle = 0;
+  while (true) {
+    std::ostringstream frame;
+    if (writable) orc::reconcile_lost_workers(db, lease_s, &frame);
+    const bool active = orc::write_status(db, sweep, frame);
+    const std::time_t now = std::time(nullptr);
+    char clock[32];
+    std::strftime(clock, sizeof clock, "%H:%M:%S", std::localtime(&now));
+    std::cout << (terminal ? "\033[H\033[2J" : "\n") << "flocsim sweep status at " << clock
+              << ", every " << every_s << " s (Ctrl-C stops watching; the sweep goes on)\n"
+              << frame.str() << std::flush;
+    // two frames without a running run: not the moment between two runs
+    idle = active ? 0 : idle + 1;
+    if (idle >= 2) {
+      std::cout << "nothing is running: stopped watching\n";
+      return kExitOk;
+    }
+    for (double slept = 0; slept < every_s; slept += 0.1) {
+      if (process::stop_requested()) return kExitOk;
+      usleep(100000);
+    }
+  }
+}
+
 void common_run_options(CLI::App& cmd, SweepOptions& o) {
   cmd.add_option("--jobs,-j", o.jobs, "Worker processes at once (local backend)")
       ->check(CLI::Range(1, 4096));
@@ -135,6 +172,23 @@ const bool registered = register_command(
        auto action = std::make_shared<std::string>();
        cmd.require_subcommand(1);
 
+       CLI::App* plan = cmd.add_subcommand(
+           "plan",
+           "What SWEEP.json will cost before it starts: every run's box, N, steps, lattice "
+           "updates, memory and wall time, and the points that would be refused");
+       plan->add_option("sweep", o->sweep_file, "Sweep file (JSON)")->required();
+       plan->add_option("--jobs,-j", o->jobs, "Worker processes at once (local backend)")
+           ->check(CLI::Range(1, 4096));
+       plan->add_option("--backend", o->backend, "Where workers would run")
+           ->check(CLI::IsMember({"local", "slurm"}));
+       plan->add_option("--db", o->plan_db,
+                        "A results database: completed runs of the same configuration give the "
+                        "rate, and runs already complete there are not counted");
+       plan->add_option("--measure-steps", o->measure_steps,
+                        "Time steps of each configuration measured here (0: none)")
+           ->check(CLI::Range(0, 1000));
+       plan->callback([action] { *action = "plan"; });
+
        CLI::App* launch = cmd.add_subcommand(
            "launch", "Expand SWEEP.json into runs, record them in the database and run them");
        launch->add_option("sweep", o->sweep_file, "Sweep file (JSON)")->required();
@@ -157,6 +211,10 @@ const bool registered = register_command(
        status->add_option("--db", o->db_path, "Results database")->required();
        status->add_option("--sweep", o->sweep_name, "Only this sweep");
        status->add_option("--lease", o->lease_s, "Heartbeat lease for remote workers (s)");
+       status
+           ->add_option("--watch", o->watch_s,
+                        "Refresh every SECONDS, in place, until nothing runs")
+           ->check(CLI::Range(0.5, 86400.0));
        status->callback([action] { *action = "status"; });
 
        CLI::App* cancel = cmd.add_subcommand(
@@ -175,10 +233,34 @@ const bool registered = register_command(
 
        return CommandHandler([o, action]() -> int {
          try {
+           if (*action == "plan") {
+             const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
+             std::unique_ptr<db::ResultsDb> db;
+             if (!o->plan_db.empty())
+               db = std::make_unique<db::ResultsDb>(o->plan_db, db::ResultsDb::Mode::kReadOnly);
+             orc::PlanOptions p;
+             p.jobs = o->jobs;
+             p.backend = o->backend;
+             p.measure_steps = o->measure_steps;
+             p.db = db.get();
+             p.progress = &std::cerr;
+             orc::write_plan(orc::plan_sweep(spec, p), std::cout, true);
+             return kExitOk;
+           }
            if (*action == "launch") {
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
              orc::expand(spec);  // a grid refused here leaves no database file behind
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
+             if (o->worker.empty() && !std::getenv("FLOCSIM_WORKER")) {
+               // what it will cost, on one screen, before anything starts (asks
+               // nothing); another --worker reads its cases its own way
+               orc::PlanOptions p;
+               p.jobs = o->jobs;
+               p.backend = o->backend;
+               p.db = &db;
+               orc::write_plan(orc::plan_sweep(spec, p), std::cout, false);
+               std::cout << std::flush;
+             }
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const std::string runs_dir =
                  o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
@@ -202,21 +284,25 @@ const bool registered = register_command(
              // status only reads, but where it may write it also marks workers
              // found dead as lost; a read-only database is read as it is
              std::unique_ptr<db::ResultsDb> opened;
+             bool writable = true;
              try {
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kExisting);
                orc::reconcile_lost_workers(*opened, o->lease_s, &std::cout);
              } catch (const db::ReadOnlyDbError&) {
+               writable = false;
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
                std::cout << o->db_path
                          << " is read-only: shown as recorded (workers that died are not "
                             "marked lost)\n";
              }
              db::ResultsDb& db = *opened;
-             orc::write_status(
-                 db,
-                 o->sweep_name.empty() ? std::nullopt : std::optional<std::string>(o->sweep_name),
-                 std::cout);
-             return kExitOk;
+             const std::optional<std::string> which =
+                 o->sweep_name.empty() ? std::nullopt : std::optional<std::string>(o->sweep_name);
+             if (o->watch_s <= 0) {
+               orc::write_status(db, which, std::cout);
+               return kExitOk;
+             }
+             return watch_status(db, writable, which, o->watch_s, o->lease_s);
            }
            if (*action == "cancel") {
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);

@@ -50,6 +50,25 @@ long Protocol::expected_total(long step) const {
   return stage2_start_ + d_.settle + d_.statistics;
 }
 
+std::pair<long, long> Protocol::length_bounds() const {
+  // The loop decides only on sample steps (multiples of d_.sample): the first
+  // decision is at the first sample, stage 1 ends at the first sample at or
+  // after its bound, stage 2 is checked from the sample after it began, and
+  // the statistics end at the first sample that completes them.
+  const long sample = d_.sample;
+  auto on_sample = [sample](long steps) {
+    return (std::max(steps, 0L) + sample - 1) / sample * sample;
+  };
+  auto length = [&](long stage1_end) {
+    const long start =
+        has_stage2_ ? stage1_end + std::max(sample, on_sample(d_.settle)) : stage1_end;
+    return start + on_sample(d_.statistics);
+  };
+  const long earliest = std::max(sample, on_sample(d_.stage1_min));
+  const long latest = std::max(sample, on_sample(std::max(d_.stage1_min, d_.stage1_max)));
+  return {length(earliest), length(latest)};
+}
+
 std::string Protocol::phase() const {
   return statistics_start_ >= 0 ? "statistics" : stage_ == 2 ? "stage 2" : "stage 1";
 }

@@ -14,6 +14,7 @@
 // checkpoint, restoring the well of a resumed stage 2.
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "engine/case/suspension_case.hpp"
@@ -50,6 +51,10 @@ class Protocol {
   bool done(long step) const;
   // The run's length in steps as far as it is known at `step`.
   long expected_total(long step) const;
+  // The run's length in steps before it starts: the shortest (stage 1 ends at
+  // stage1_min, stationary at once) and the longest (stage1_max reached), with
+  // every stage boundary on a sample step as the loop decides it.
+  std::pair<long, long> length_bounds() const;
   // "stage 1", "stage 2" or "statistics", for progress lines.
   std::string phase() const;
 

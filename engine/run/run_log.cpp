@@ -123,6 +123,7 @@ void ProgressReporter::report(long step, const std::string& extra) {
                       {"mlups", m},
                       {"updated_at", static_cast<double>(std::time(nullptr))},
                       {"pid", static_cast<long>(::getpid())}};
+  for (auto it = state_.begin(); it != state_.end(); ++it) j[it.key()] = it.value();
   output::write_file_atomically(progress_json_, j.dump() + "\n");
 }
 

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 namespace flocsim::run {
 
@@ -48,6 +50,9 @@ class ProgressReporter {
   void finish(long step);
   // Runs whose length is decided on the way (stationarity) revise their total.
   void set_steps_total(long steps_total);
+  // Where the run stands in its own terms (its stage, its simulated time),
+  // written into progress.json with the next report for `flocsim sweep status`.
+  void set_state(nlohmann::json state) { state_ = std::move(state); }
   double mlups(long step) const;
 
  private:
@@ -56,6 +61,7 @@ class ProgressReporter {
   std::filesystem::path progress_json_;
   long first_step_, steps_total_, cells_;
   double every_s_;
+  nlohmann::json state_ = nlohmann::json::object();
   std::chrono::steady_clock::time_point start_, last_print_, last_json_;
 };
 

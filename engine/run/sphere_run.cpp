@@ -24,6 +24,31 @@
 
 namespace flocsim::run {
 
+void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
+                   const spheres::PeriodicBox& box, spheres::SphereSet& s) {
+  s.resize(static_cast<std::size_t>(c.derived.sphere_count));
+  if (c.scene == cases::Scene::single_sphere) {
+    s.position[0] = 0.5 * box.length;
+    return;
+  }
+  if (!c.initial_positions.empty()) {
+    for (std::size_t i = 0; i < s.size(); ++i)
+      s.position[i] = spheres::Vec3(c.initial_positions[3 * i], c.initial_positions[3 * i + 1],
+                                    c.initial_positions[3 * i + 2]);
+    return;  // held still where a snapshot left them
+  }
+  s.position = placement::place_randomly(
+      {c.derived.sphere_count, c.numerics.radius_cells, 0.0, c.seed}, box);
+  if (m.liquid) return;  // spheres and liquid start at rest
+  // granular gas: Maxwellian velocities with U_inf per component, no net momentum
+  std::mt19937_64 rng(c.seed + 1);
+  std::normal_distribution<double> maxwell(0.0, c.derived.settling_velocity);
+  spheres::Vec3 mean = spheres::Vec3::Zero();
+  for (auto& v : s.velocity) mean += (v = spheres::Vec3(maxwell(rng), maxwell(rng), maxwell(rng)));
+  mean /= static_cast<double>(c.derived.sphere_count);
+  for (auto& v : s.velocity) v -= mean;
+}
+
 namespace {
 
 using spheres::Vec3;
@@ -46,32 +71,6 @@ observables::PairStructure pair_structure_for(const cases::SuspensionCase& c) {
 // Slabs of phi(x, t): one per sphere radius along x.
 int phi_slabs(const cases::SuspensionCase& c) {
   return std::max(1, static_cast<int>(std::lround(c.derived.box.nx / c.numerics.radius_cells)));
-}
-
-// Initial positions and velocities of a fresh start.
-void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
-                   const spheres::PeriodicBox& box, spheres::SphereSet& s) {
-  s.resize(static_cast<std::size_t>(c.derived.sphere_count));
-  if (c.scene == cases::Scene::single_sphere) {
-    s.position[0] = 0.5 * box.length;
-    return;
-  }
-  if (!c.initial_positions.empty()) {
-    for (std::size_t i = 0; i < s.size(); ++i)
-      s.position[i] = Vec3(c.initial_positions[3 * i], c.initial_positions[3 * i + 1],
-                           c.initial_positions[3 * i + 2]);
-    return;  // held still where a snapshot left them
-  }
-  s.position = placement::place_randomly(
-      {c.derived.sphere_count, c.numerics.radius_cells, 0.0, c.seed}, box);
-  if (m.liquid) return;  // spheres and liquid start at rest
-  // granular gas: Maxwellian velocities with U_inf per component, no net momentum
-  std::mt19937_64 rng(c.seed + 1);
-  std::normal_distribution<double> maxwell(0.0, c.derived.settling_velocity);
-  Vec3 mean = Vec3::Zero();
-  for (auto& v : s.velocity) mean += (v = Vec3(maxwell(rng), maxwell(rng), maxwell(rng)));
-  mean /= static_cast<double>(c.derived.sphere_count);
-  for (auto& v : s.velocity) v -= mean;
 }
 
 std::string health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
@@ -272,6 +271,11 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
         std::snprintf(extra, sizeof extra, "%s | t U/a %.1f | C_sph %.3f | <n_a> %.3f",
                       phase.c_str(), s.step / c.derived.convective_time,
                       s.series[column::C_sph].back(), s.series[column::mean_aggregate_size].back());
+      progress.set_state(
+          {{"stage", phase},
+           {"time", s.step / c.derived.convective_time},
+           {"time_total", protocol.expected_total(s.step) / c.derived.convective_time},
+           {"time_unit", "a/U_inf"}});
       progress.update(s.step, extra);
     }
   }

@@ -18,10 +18,17 @@
 // per-stage cost and the derived lattice-unit quantities.
 #include "engine/case/suspension_case.hpp"
 #include "engine/run/fluid_run.hpp"
+#include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::run {
 
 // A scene without spheres is refused (input::InputError).
 RunReport run_sphere_case(const cases::SuspensionCase& c, const RunOptions& options);
+
+// The spheres of a fresh start: a single sphere in the middle, a snapshot's
+// centres, or random non-overlapping positions (at rest with a liquid; with
+// Maxwellian velocities of no net momentum in a granular gas).
+void place_spheres(const cases::SuspensionCase& c, const cases::SceneModules& m,
+                   const spheres::PeriodicBox& box, spheres::SphereSet& s);
 
 }  // namespace flocsim::run

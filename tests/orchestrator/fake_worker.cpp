@@ -8,7 +8,8 @@
 //   "truncate": false,               write a cut-off result.json, then exit 0
 //   "refuse": false,                 exit 2 at once, as bad input
 //   "crash_at": -1,                  abort() at this step
-//   "hang_at": -1 }                  stop heart-beating (but keep living) at this step
+//   "hang_at": -1,                   stop heart-beating (but keep living) at this step
+//   "by_x": {"2": {...}} }           overrides of these fields for the run with x = 2
 // Each step rewrites progress.json and checkpoint.h5 (the step number), both
 // atomically. SIGTERM/SIGINT: checkpoint, exit 3. --resume: continue from the
 // checkpoint. Every start appends "start STEP" to DIR/starts.log.
@@ -63,7 +64,13 @@ int main(int argc, char** argv) {
 
   std::ifstream cf(case_file);
   const nlohmann::json c = nlohmann::json::parse(cf);
-  const nlohmann::json fake = c.value("fake", nlohmann::json::object());
+  nlohmann::json fake = c.value("fake", nlohmann::json::object());
+  // "by_x": {"2": {"exit": 1}}: overrides for the run whose x is 2
+  if (fake.contains("by_x")) {
+    char key[32];
+    std::snprintf(key, sizeof key, "%g", c.value("x", 0.0));
+    if (fake["by_x"].contains(key)) fake.update(fake["by_x"][key]);
+  }
   const long steps = fake.value("steps", 10L);
   const long step_ms = fake.value("step_ms", 50L);
   const int exit_code = fake.value("exit", 0);
@@ -102,11 +109,18 @@ int main(int argc, char** argv) {
     if (beating) {
       write_atomic(dir + "/checkpoint.h5", std::to_string(step) + "\n");
       const double frac = static_cast<double>(step) / static_cast<double>(steps);
-      nlohmann::json p{
-          {"step", step},     {"steps_total", steps},
-          {"fraction", frac}, {"eta_s", 0.001 * static_cast<double>((steps - step) * step_ms)},
-          {"mlups", 1.5},     {"updated_at", now_s()},
-          {"pid", getpid()}};
+      nlohmann::json p{{"step", step},
+                       {"steps_total", steps},
+                       {"fraction", frac},
+                       {"eta_s", 0.001 * static_cast<double>((steps - step) * step_ms)},
+                       {"mlups", 1.5},
+                       {"updated_at", now_s()},
+                       {"pid", getpid()},
+                       // where the run stands in its own terms, as flocsim's sphere scenes write it
+                       {"stage", 2 * step < steps ? "stage 1" : "statistics"},
+                       {"time", 0.5 * static_cast<double>(step)},
+                       {"time_total", 0.5 * static_cast<double>(steps)},
+                       {"time_unit", "a/U_inf"}};
       write_atomic(dir + "/progress.json", p.dump());
     } else {
       --step;  // hung: no progress at all

@@ -15,6 +15,8 @@
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
+#include "orchestrator/plan.hpp"
+#include "orchestrator/sweep.hpp"
 
 namespace fs = std::filesystem;
 using flocsim::db::ResultsDb;
@@ -180,6 +182,11 @@ TEST_F(Orchestrator, KilledWorkerIsLostThenResumedFromItsCheckpoint) {
   EXPECT_EQ(orch.wait(), 1) << t::read_text(dir_ / "launch.log");
   EXPECT_EQ(statuses()[1], "lost");
   EXPECT_EQ(statuses()[2], "completed");
+  t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_NE(st.out.find("lost 1 (1 attempt lost in all), recovered 0"), std::string::npos)
+      << st.out;
+  EXPECT_NE(st.out.find("flocsim sweep resume --db " + db_ + " --sweep fake"), std::string::npos)
+      << st.out;
   {
     ResultsDb db(db_, ResultsDb::Mode::kExisting);
     for (const auto& r : db.runs())
@@ -194,6 +201,9 @@ TEST_F(Orchestrator, KilledWorkerIsLostThenResumedFromItsCheckpoint) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("(resuming)"), std::string::npos) << r.out;
   EXPECT_EQ(statuses()[1], "completed");
+  st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_NE(st.out.find("lost 0 (1 attempt lost in all), recovered 1"), std::string::npos)
+      << st.out;
   // Two starts: from 0, then from the checkpoint the killed worker left.
   const std::string starts = t::read_text(run_dir(1) / "starts.log");
   int second = -1;
@@ -341,6 +351,67 @@ TEST_F(Orchestrator, SilentWorkerLosesItsLease) {
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   EXPECT_NE(db.runs().front().error.find("no heartbeat"), std::string::npos)
       << db.runs().front().error;
+}
+
+TEST_F(Orchestrator, StatusFollowsARunningAFailedAndACompletedRun) {
+  // x = 1 completes at once, x = 2 fails (its first retry is still allowed),
+  // x = 3 runs for a minute writing progress.json as flocsim's sphere scenes do:
+  // stage, simulated time and its total (fake worker: 0.5 a/U_inf per step).
+  const std::string sweep =
+      fake_sweep({1, 2, 3}, 3, 20,
+                 {{"by_x", {{"2", {{"exit", 1}}}, {"3", {{"steps", 3000}, {"step_ms", 20}}}}}});
+  t::Background pool = t::start(launch(sweep, 3), (dir_ / "launch.log").string());
+  ASSERT_TRUE(t::wait_for(
+      [&] {
+        if (!fs::exists(db_)) return false;
+        auto st = statuses();
+        return st[1] == "completed" && st[2] == "failed" && st[3] == "running" &&
+               progress_step(3) >= 10;
+      },
+      30))
+      << t::read_text(dir_ / "launch.log");
+  const t::Output o = t::run(flocsim({"sweep", "status", "--db", db_}));
+  ASSERT_EQ(o.code, 0) << o.out;
+  // the counts, with lost and recovered runs
+  EXPECT_NE(o.out.find("sweep fake: 3 runs:"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("completed 1"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("running 1"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("failed 1"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("lost 0 (0 attempts lost in all), recovered 0"), std::string::npos) << o.out;
+  // the running run: its stage, simulated time of its total, share done, ETA
+  std::istringstream lines(o.out);
+  std::string line, running_line, failed_line;
+  while (std::getline(lines, line)) {
+    if (line.find("x=3") != std::string::npos) running_line = line;
+    if (line.find("x=2") != std::string::npos) failed_line = line;
+  }
+  EXPECT_NE(running_line.find("stage 1"), std::string::npos) << o.out;
+  EXPECT_NE(running_line.find("/1500 a/U_inf"), std::string::npos) << o.out;  // 3000 steps x 0.5
+  EXPECT_NE(running_line.find("%"), std::string::npos) << o.out;
+  EXPECT_NE(running_line.find(" s "), std::string::npos) << o.out;  // its ETA, about a minute
+  // the failed run: the first line of its reason, and the command that retries it
+  EXPECT_NE(failed_line.find("failed"), std::string::npos) << o.out;
+  EXPECT_NE(failed_line.find("numerical blow-up at step 3"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("flocsim sweep resume --db " + db_ + " --sweep fake"), std::string::npos)
+      << o.out;
+  EXPECT_NE(o.out.find("ETA: about"), std::string::npos) << o.out;
+
+  // --watch refreshes until nothing runs: stopping the sweep ends it
+  t::Background watch = t::start(flocsim({"sweep", "status", "--db", db_, "--watch", "0.5"}),
+                                 (dir_ / "watch.log").string());
+  ASSERT_TRUE(t::wait_for(
+      [&] {
+        const std::string w = t::read_text(dir_ / "watch.log");
+        return w.find("flocsim sweep status at") != w.rfind("flocsim sweep status at");
+      },
+      20))
+      << t::read_text(dir_ / "watch.log");
+  kill(pool.pid, SIGTERM);
+  EXPECT_EQ(pool.wait(60), 3);
+  EXPECT_EQ(watch.wait(20), 0) << t::read_text(dir_ / "watch.log");
+  EXPECT_NE(t::read_text(dir_ / "watch.log").find("nothing is running: stopped watching"),
+            std::string::npos)
+      << t::read_text(dir_ / "watch.log");
 }
 
 TEST_F(Orchestrator, BadInputGetsClearErrorsAndExitCode2) {
@@ -510,6 +581,73 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
 
 // The real worker: the CI sweep with `flocsim run`, then a real run killed with
 // SIGKILL and resumed from its HDF5 checkpoint.
+TEST_F(Orchestrator, PlanRefusesWhatLaunchRefusesAndCountsTheRunsLatticeUpdates) {
+  // Three points at the draft preset (a = 4, 64 x 32 x 32 cells, 49 spheres):
+  // Re_inf 24 runs, 48 and 72 are refused (a = 4 caps Re_inf at 40). Stage 1
+  // has a fixed length (stage1_min = stage1_max), so the run's length is known
+  // exactly: the plan's lattice updates must be the run's own steps x cells.
+  json s{{"name", "plancheck"},
+         {"base",
+          {{"scene", "suspension"},
+           {"fidelity", "draft"},
+           {"phi", 0.2},
+           {"precision", "float"},
+           {"du_over_Uinf", 0.03},
+           {"numerics", {{"U_inf", 0.03}}},
+           {"protocol",
+            {{"stage1_min", 3},
+             {"stage1_max", 3},
+             {"stage2_settle", 1},
+             {"statistics", 10},
+             {"snapshot_every", 0},
+             {"threads", 1}}}}},
+         {"axes", {{"Re_inf", {24, 48, 72}}}}};
+  const std::string sweep = (dir_ / "plancheck.json").string();
+  t::write_text(sweep, s.dump(2));
+  const t::Output plan = t::run(flocsim({"sweep", "plan", sweep, "--measure-steps", "2"}));
+  ASSERT_EQ(plan.code, 0) << plan.out;
+  EXPECT_NE(plan.out.find("3 points, 1 to run, 2 refused"), std::string::npos) << plan.out;
+  const t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--jobs", "1"}));
+  EXPECT_EQ(o.code, 1) << o.out;  // two runs refused
+  // launch printed the same plan first
+  EXPECT_NE(o.out.find("plan of sweep plancheck: 3 points, 1 to run, 2 refused"), std::string::npos)
+      << o.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  int refused = 0;
+  for (const auto& row : db.result_rows()) {
+    const double re = json::parse(row.run.case_json)["Re_inf"];
+    if (row.run.status == RunState::kRefused) {
+      ++refused;
+      EXPECT_NE(re, 24);
+      // the run's message, first line, is the one the plan printed for it
+      const std::string first = row.run.error.substr(row.run.error.find("input error"));
+      const std::string reason = first.substr(first.find(": ") + 2, 60);
+      EXPECT_NE(plan.out.find(reason), std::string::npos) << reason << "\n" << plan.out;
+      continue;
+    }
+    ASSERT_EQ(row.run.status, RunState::kCompleted) << row.run.error;
+    const json result = json::parse(row.result_json);
+    const json box = result["derived"]["box_cells"];
+    const long updates = result["cost"]["steps"].get<long>() * box[0].get<long>() *
+                         box[1].get<long>() * box[2].get<long>();
+    // the plan's row for it shows these steps, and its count is exactly theirs
+    std::istringstream lines(plan.out);
+    std::string line, planned;
+    while (std::getline(lines, line))
+      if (line.find("Re_inf=24") != std::string::npos) planned = line;
+    EXPECT_NE(planned.find("  " + std::to_string(result["cost"]["steps"].get<long>()) + "  "),
+              std::string::npos)
+        << planned;
+    flocsim::orchestrator::PlanOptions options;
+    options.measure_steps = 0;
+    const auto exact =
+        flocsim::orchestrator::plan_sweep(flocsim::orchestrator::read_sweep_file(sweep), options);
+    EXPECT_EQ(exact.lattice_updates_min, static_cast<double>(updates));
+    EXPECT_EQ(exact.lattice_updates_max, static_cast<double>(updates));
+  }
+  EXPECT_EQ(refused, 2);
+}
+
 TEST_F(Orchestrator, RealFlocsimRunCompletesTheCiSweep) {
   const t::Output o = t::run(flocsim(
       {"sweep", "launch", FLOCSIM_SOURCE_DIR "/sweeps/ci.json", "--db", db_, "--jobs", "2"}));

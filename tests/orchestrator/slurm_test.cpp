@@ -100,6 +100,14 @@ TEST_F(Slurm, CancelledJobIsResumedFromCheckpointsByANewArray) {
     return ready == 2;
   };
   ASSERT_TRUE(t::wait_for([&] { return stepped(5); }, 60)) << t::read_text(dir_ / "launch.log");
+  // status follows Slurm jobs as it does local workers, from their progress files:
+  // each run's stage, simulated time of its total (fake worker: 0.5 a/U_inf per
+  // step, 200 steps) and its array job
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_NE(st.out.find("running (2)"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("/100 a/U_inf"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("stage 1"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find(" job "), std::string::npos) << st.out;
   const t::Output c = t::run(flocsim({"sweep", "cancel", "--db", db_}));
   EXPECT_EQ(c.code, 0) << c.out;
   EXPECT_NE(c.out.find("scancel"), std::string::npos) << c.out;

@@ -30,6 +30,7 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct HandRun {
   std::string id;
@@ -63,10 +64,11 @@ class Post : public ::testing::Test {
   }
 
   // Writes the runs through db/'s API as the orchestrator would.
-  std::string write_db(const std::vector<HandRun>& runs, bool with_series = false) {
+  std::string write_db(const std::vector<HandRun>& runs, bool with_series = false,
+                       const std::string& sweep_name = "hand") {
     const std::string path = (dir_ / "results.db").string();
     db::ResultsDb db(path, db::ResultsDb::Mode::kCreate);
-    const auto sweep = db.upsert_sweep("hand", "{}", "[\"du_over_Uinf\"]", 2);
+    const auto sweep = db.upsert_sweep(sweep_name, "{}", "[\"du_over_Uinf\"]", 2);
     std::vector<db::ResultsDb::NewRun> news;
     for (const HandRun& r : runs)
       news.push_back({r.id, orchestrator::canonical_text(r.case_json), (dir_ / r.id).string(),
@@ -462,7 +464,42 @@ TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
   html << in.rdbuf();
   EXPECT_THAT(html.str(), HasSubstr("data:image/png;base64,iVBORw0KGgo"));  // an embedded PNG
   EXPECT_THAT(html.str(), HasSubstr("0.75 ± 0.03"));
-  EXPECT_THAT(html.str(), HasSubstr("<td>completed</td>"));
+  EXPECT_THAT(html.str(), HasSubstr(">completed</td>"));  // the provenance table's state
+}
+
+TEST_F(Post, NoSingleValueWidensTheReportsTablesBeyondThePage) {
+  // A sweep name a script made from every parameter: before, it stretched the
+  // provenance table to ten page widths, and the tables ran off a 1400-pixel page.
+  std::string long_name = "paper-grid";
+  while (long_name.size() < 300)
+    long_name += "-phi0.2-Re12-du0.02-a6-standard-seed" + std::to_string(long_name.size());
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4}},
+               false, long_name);
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  write_report(runs, FigureSet{}, db_path, dir_ / "report.html");
+  std::ifstream in(dir_ / "report.html");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string html = text.str();
+  // the name is never a cell's whole visible text: it is cut, the whole on hover
+  EXPECT_THAT(html, Not(HasSubstr(">" + long_name + "<")));
+  EXPECT_THAT(html, HasSubstr("title='" + long_name + "'"));
+  EXPECT_THAT(html, HasSubstr(">" + long_name.substr(0, 20)));
+  EXPECT_THAT(html, HasSubstr("\u2026"));  // the ellipsis that marks the cut
+  // every table scrolls inside its own box instead of widening the page
+  std::size_t tables = 0, boxed = 0;
+  for (std::size_t at = html.find("<table"); at != std::string::npos;
+       at = html.find("<table", at + 1)) {
+    ++tables;
+    boxed +=
+        html.rfind("<div class='scroll'>", at) == at - std::string("<div class='scroll'>").size();
+  }
+  EXPECT_GE(tables, 3u);
+  EXPECT_EQ(boxed, tables);
+  EXPECT_THAT(html, HasSubstr(".scroll{overflow:auto"));
 }
 
 }  // namespace

@@ -1,0 +1,152 @@
+// `flocsim sweep plan`: every point of a grid read by the run's own parser (a
+// refused point carries the run's message), sized from the run's own protocol
+// (steps worked by hand from the fidelity preset), and timed and weighed by
+// building the case's real coupled step.
+#include "orchestrator/plan.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "engine/case/case_file.hpp"
+#include "engine/input/input_reader.hpp"
+#include "orchestrator/sweep.hpp"
+
+namespace orc = flocsim::orchestrator;
+using ::testing::HasSubstr;
+
+namespace {
+
+orc::SweepSpec paper_grid(const std::string& fidelity) {
+  orc::SweepSpec spec =
+      orc::read_sweep_file(std::string(FLOCSIM_SOURCE_DIR) + "/sweeps/paper.json");
+  spec.base["fidelity"] = fidelity;
+  return spec;
+}
+
+TEST(SweepPlan, ThePapersGridIsSizedFromItsProtocol) {
+  orc::PlanOptions o;
+  o.measure_steps = 0;  // sizes only
+  const orc::SweepPlan plan = orc::plan_sweep(paper_grid("paper"), o);
+  ASSERT_EQ(plan.runs.size(), 120u);
+  EXPECT_EQ(plan.refused, 0);
+  EXPECT_EQ(plan.to_run, 120);
+  // By hand, the paper preset (docs/user-guide.md): a = 6 dx, L = 48a, L/W = 2:
+  // 288 x 144 x 144 = 5 971 968 cells. At phi 0.2, Re_inf 12, U_inf = 0.02 (the
+  // default; nu = 2 a U_inf / Re_inf = 0.02 is above the floor): a/U_inf = 300
+  // steps, samples every 150. Stage 1 of 30-150 a/U_inf = 9 000-45 000 steps,
+  // with the well 100 a/U_inf to settle (30 000) and 300 of statistics (90 000):
+  // 129 000-165 000 steps; without the well no stage 2: 99 000-135 000.
+  int checked = 0;
+  for (const orc::PlannedRun& r : plan.runs) {
+    const auto& c = r.point.case_json;
+    if (c["phi"] != 0.2 || c["Re_inf"] != 12) continue;
+    EXPECT_EQ(r.size.cells, 5971968);
+    EXPECT_EQ(r.size.box.nx, 288);
+    const bool well = c["du_over_Uinf"].get<double>() > 0;
+    EXPECT_EQ(r.size.steps_min, well ? 129000 : 99000) << c.dump();
+    EXPECT_EQ(r.size.steps_max, well ? 165000 : 135000) << c.dump();
+    ++checked;
+  }
+  EXPECT_EQ(checked, 6);
+  // the totals are the sum over the runs
+  double low = 0, high = 0;
+  for (const orc::PlannedRun& r : plan.runs) {
+    low += static_cast<double>(r.size.cells) * r.size.steps_min;
+    high += static_cast<double>(r.size.cells) * r.size.steps_max;
+  }
+  EXPECT_DOUBLE_EQ(plan.lattice_updates_min, low);
+  EXPECT_DOUBLE_EQ(plan.lattice_updates_max, high);
+  // without a rate there is no time estimate, and the plan says why
+  EXPECT_FALSE(plan.wall_min_s);
+  std::ostringstream text;
+  orc::write_plan(plan, text, true);
+  EXPECT_THAT(text.str(), HasSubstr("plan of sweep paper: 120 points, 120 to run, 0 refused"));
+  EXPECT_THAT(text.str(), HasSubstr("--measure-steps"));
+}
+
+TEST(SweepPlan, RefusesExactlyWhatTheRunRefusesWithItsMessage) {
+  // The draft preset refuses the 48 points at Re_inf 48 and 72 (a = 4 caps
+  // Re_inf at 40: tests/run/paper_grid_test.cpp); the plan must say so for each,
+  // with the message `flocsim run` gives, which names what would work.
+  orc::PlanOptions o;
+  o.measure_steps = 0;
+  const orc::SweepPlan plan = orc::plan_sweep(paper_grid("draft"), o);
+  ASSERT_EQ(plan.runs.size(), 120u);
+  EXPECT_EQ(plan.refused, 48);
+  for (const orc::PlannedRun& r : plan.runs) {
+    std::string run_says;
+    try {
+      flocsim::cases::parse_case(r.point.case_json);
+    } catch (const flocsim::input::InputError& e) {
+      run_says = e.what();
+    }
+    EXPECT_EQ(r.refused, run_says) << r.point.point.dump();
+    const double re = r.point.case_json["Re_inf"];
+    EXPECT_EQ(!r.refused.empty(), re == 48 || re == 72) << r.point.point.dump();
+    if (!r.refused.empty()) {
+      EXPECT_THAT(r.refused, HasSubstr("raise numerics.a_over_dx to at least 6"));
+    }
+  }
+  std::ostringstream screen;
+  orc::write_plan(plan, screen, false);
+  EXPECT_THAT(screen.str(), HasSubstr("refused (48), as `flocsim run` refuses them"));
+  EXPECT_THAT(screen.str(), HasSubstr("raise numerics.a_over_dx to at least 6"));
+}
+
+TEST(SweepPlan, TimesTheRealStepAndWeighsTheLatticesStorage) {
+  // The demo sweep: one configuration (64 x 32 x 32 float lattice, 49 spheres,
+  // one-sweep IB) shared by its four points.
+  orc::PlanOptions o;
+  o.measure_steps = 5;
+  o.measure_seconds = 0.2;
+  const orc::SweepPlan plan = orc::plan_sweep(
+      orc::read_sweep_file(std::string(FLOCSIM_SOURCE_DIR) + "/sweeps/demo.json"), o);
+  ASSERT_EQ(plan.costs.size(), 1u);
+  const orc::StepCost& c = plan.costs.front();
+  EXPECT_EQ(c.runs, 4);
+  ASSERT_TRUE(c.measured);
+  EXPECT_GE(c.measured->steps, 5);
+  EXPECT_GT(c.measured->step_s, 0);
+  EXPECT_EQ(c.measured->threads, 1);  // the demo's protocol.threads
+  // The lattice's storage by hand: 19 populations, the 3-component force field
+  // and the immersed boundary's (rho, u*) rows: 26 floats per cell; the
+  // spheres and markers add little. The state allocated must hold at least that
+  // and not twice it.
+  const double storage = 26.0 * 4 * 64 * 32 * 32;
+  EXPECT_GE(c.measured->memory_bytes, storage);
+  EXPECT_LE(c.measured->memory_bytes, 2 * storage);
+  // Steps by hand: a/U_inf = 4 / 0.03 = 133.3 steps, samples every 67; stage 1
+  // of 8-15 a/U_inf ends on the sample at or after 1067-2000 steps: 1072-2010;
+  // with the well 8 a/U_inf to settle (1072) and 16 of statistics (2144).
+  for (const orc::PlannedRun& r : plan.runs) {
+    const bool well = r.point.case_json["du_over_Uinf"].get<double>() > 0;
+    EXPECT_EQ(r.size.steps_min, well ? 1072 + 1072 + 2144 : 1072 + 2144);
+    EXPECT_EQ(r.size.steps_max, well ? 2010 + 1072 + 2144 : 2010 + 2144);
+  }
+  // a run: its setup and its steps at the measured rate
+  for (const orc::PlannedRun& r : plan.runs) {
+    ASSERT_TRUE(r.wall_min_s);
+    EXPECT_NEAR(*r.wall_min_s, c.measured->setup_s + r.size.steps_min * c.measured->step_s,
+                1e-9 * *r.wall_min_s);
+  }
+  // one job: the sweep is the runs one after another
+  double sum = 0;
+  for (const orc::PlannedRun& r : plan.runs) sum += *r.wall_max_s;
+  ASSERT_TRUE(plan.wall_max_s);
+  EXPECT_NEAR(*plan.wall_max_s, sum, 1e-9 * sum);
+}
+
+TEST(SweepPlan, ReadsSlurmTimeLimitsInEveryForm) {
+  EXPECT_EQ(orc::slurm_time_limit_s("90"), 5400);            // minutes
+  EXPECT_EQ(orc::slurm_time_limit_s("10:30"), 630);          // minutes:seconds
+  EXPECT_EQ(orc::slurm_time_limit_s("01:00:00"), 3600);      // hours:minutes:seconds
+  EXPECT_EQ(orc::slurm_time_limit_s("2-00:00:00"), 172800);  // days-hours:minutes:seconds
+  EXPECT_EQ(orc::slurm_time_limit_s("1-12"), 129600);        // days-hours
+  EXPECT_EQ(orc::slurm_time_limit_s("1-01:30"), 91800);      // days-hours:minutes
+  EXPECT_FALSE(orc::slurm_time_limit_s("soon"));
+  EXPECT_FALSE(orc::slurm_time_limit_s("1:2:3:4"));
+}
+
+}  // namespace
