@@ -178,19 +178,31 @@ CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::v
   for (int L : boxes)
     for (double d : offsets) flows.push_back(std::make_unique<ArrayFlow>(L, settings, d));
   double ag = hydrodynamic_radius - 0.3;  // typical offset, refined below
-  for (int pass = 0; pass < 3; ++pass) {
+  // Passes of fixed-point updates, a_g = a - (mean a - a_g) of the last
+  // pass; from the third on, where the offset itself moves with a_g (control
+  // forcing: its marker count and the lattice cells its kernels reach change
+  // in steps), secant updates through the last two passes.
+  double previous_ag = 0, previous_a = 0;
+  for (int pass = 0; pass < 6; ++pass) {
     e.checks.clear();
-    double mean_offset = 0;
+    double mean_a = 0;
     for (auto& flow : flows) {
       e.checks.push_back(flow->run_to_steady(ag));
       if (progress) progress(e.checks.back());
-      mean_offset += e.checks.back().hydrodynamic_radius - ag;
+      mean_a += e.checks.back().hydrodynamic_radius;
     }
-    mean_offset /= static_cast<double>(flows.size());
+    mean_a /= static_cast<double>(flows.size());
     e.input_radius = ag;
-    const double miss = ag + mean_offset - hydrodynamic_radius;
+    const double miss = mean_a - hydrodynamic_radius;
     if (pass > 0 && std::abs(miss) <= 0.01) break;
-    ag = hydrodynamic_radius - mean_offset;
+    double next = ag - miss;  // the fixed point
+    if (pass >= 2 && std::abs(ag - previous_ag) > 1e-6) {
+      const double slope = (mean_a - previous_a) / (ag - previous_ag);
+      if (slope > 0.2 && slope < 5) next = ag - miss / slope;
+    }
+    previous_ag = ag;
+    previous_a = mean_a;
+    ag = next;
   }
   return e;
 }

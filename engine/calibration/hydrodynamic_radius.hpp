@@ -80,8 +80,9 @@ struct CalibrationEntry {
 };
 
 // Finds a_g for the wanted a: runs the boxes with a first guess, shifts a_g by
-// the mean offset a - a_g measured, runs again, and repeats the shift once
-// more when the boxes disagree with the wanted a by more than 0.01 dx.
+// the mean offset a - a_g measured, runs again, and goes on while the boxes'
+// mean misses the wanted a by more than 0.01 dx (up to six passes; from the
+// third on a secant step, for schemes whose offset moves with a_g).
 // `progress` (may be empty) receives one line per run.
 CalibrationEntry calibrate_input_radius(double hydrodynamic_radius, const std::vector<int>& boxes,
                                         const ArrayDragSettings& settings,
