@@ -43,6 +43,7 @@ struct CalibrateOptions {
   bool separating = false;
   std::vector<double> gaps;
   double pair_box_over_a = 16;
+  double input_radius = 0;  // close pairs: a_g by hand (0: the shipped calibration's)
 };
 
 coupling::Scheme scheme_of(const CalibrateOptions& o) {
@@ -79,6 +80,7 @@ int run_pair_calibration(const CalibrateOptions& o) {
   s.viscosity = o.viscosity;
   s.scheme = scheme_of(o);
   s.box_over_a = o.pair_box_over_a;
+  s.input_radius = o.input_radius;
   const auto gaps = o.gaps.empty() ? calibration::default_pair_gaps() : o.gaps;
   for (double a : o.radii) {
     std::printf("close pair, a = %g dx, nu = %g, %s, %s:\n", a, o.viscosity,
@@ -188,6 +190,10 @@ const bool registered = register_command(
                       "with --close-pairs: box length along the pair in units of a (cross-section "
                       "half of it)")
            ->check(CLI::Range(8.0, 64.0));
+       cmd.add_option("--input-radius", o->input_radius,
+                      "with --close-pairs: the spheres' input radius a_g (default: the shipped "
+                      "calibration's for the scheme at --radius and --viscosity)")
+           ->check(CLI::Range(1.0, 40.0));
        cmd.add_option("--table", o->table, "calibration table (JSON), read and extended")
            ->required();
        return [o] { return run_calibrate(*o); };

@@ -20,6 +20,13 @@ namespace flocsim::calibration {
 
 namespace {
 
+// The input radius the pair is measured with: given, or the shipped calibration's.
+double input_radius_of(double a, const PairResistanceSettings& set) {
+  return set.input_radius > 0
+             ? set.input_radius
+             : CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme);
+}
+
 // Two spheres of hydrodynamic radius a held on the x axis of a periodic box
 // L x L/2 x L/2, moving along their line of centres at +-V, without lubrication.
 class HeldPair {
@@ -32,8 +39,7 @@ class HeldPair {
         V_(0.5 * set.reynolds * set.viscosity / a),
         set_(set),
         fluid_({box_, box_ / 2, box_ / 2}, {set.viscosity, 0.25}),
-        coupling_(coupling::make_coupling<double>(
-            set.scheme, CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme))) {
+        coupling_(coupling::make_coupling<double>(set.scheme, input_radius_of(a, set))) {
     fluid_.initialise_equilibrium([](int, int, int) { return lattice::Macroscopic{}; });
     pair_.radius = a;
     pair_.resize(2);
@@ -129,6 +135,7 @@ PairResistanceEntry calibrate_pair_resistance(double a, const std::vector<double
     if (progress) progress(e.points.back());
   }
   e.box_offset = e.points.back().lambda_measured - e.points.back().lambda_exact;
+  e.input_radius = input_radius_of(a, s);
   return e;
 }
 
@@ -150,6 +157,7 @@ void PairResistanceTable::save(const std::string& filename) const {
                          {"box", e.box},
                          {"separating", e.separating},
                          {"box_offset", e.box_offset},
+                         {"input_radius", e.input_radius},
                          {"points", points}};
     write_scheme(je, e.scheme);
     j["entries"].push_back(je);
@@ -188,6 +196,7 @@ PairResistanceTable PairResistanceTable::parse(const std::string& json_text,
       e.box = je.at("box").get<int>();
       e.separating = je.at("separating").get<bool>();
       e.box_offset = je.at("box_offset").get<double>();
+      e.input_radius = je.value("input_radius", 0.0);
       for (const auto& jp : je.at("points"))
         e.points.push_back({jp.at("gap_over_a").get<double>(),
                             jp.at("lambda_measured").get<double>(),

@@ -29,6 +29,10 @@ struct PairResistanceSettings {
   double reynolds = 0.01;   // 2 a V / nu: creeping flow
   double tolerance = 2e-6;  // steady: relative change of lambda per 200 steps
   long max_steps = 1000000;
+  // The input radius a_g; 0: the shipped hydrodynamic-radius calibration's
+  // for the scheme at a and nu (a scheme calibrated but not shipped at this a
+  // is measured with its own calibration's a_g, given here).
+  double input_radius = 0;
 };
 
 // One held pair at gap s (in units of a), from a liquid at rest; returns
@@ -53,6 +57,7 @@ struct PairResistanceEntry {
   coupling::Scheme scheme;
   int box = 0;  // length along the line of centres (dx); the cross-section is half
   bool separating = false;
+  double input_radius = 0;                  // a_g the pair was measured with (0: not recorded)
   double box_offset = 0;                    // lambda_measured - lambda_exact at the largest gap
   std::vector<PairResistancePoint> points;  // increasing gap_over_a
   // lambda_IB(s/a) = lambda_measured - box_offset, linear between points, held
