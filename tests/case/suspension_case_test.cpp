@@ -526,5 +526,34 @@ TEST(SuspensionCaseCoupling, ControlGainsOutsideTheMeasuredStableRegionAreRefuse
   }
 }
 
+// Control forcing's radius is not shipped (it varies with the solid fraction
+// by more than the shipped entries' 0.02 dx): a case gets it by hand, in the
+// range where control forcing puts its wall (up to 1.5 dx outside its
+// markers). Partially saturated cells come from the shipped table. Each is
+// written into the canonical case, so that runs of different schemes never
+// share an identity.
+TEST(SuspensionCaseCoupling, ControlForcingByHandAndPartiallySaturatedCellsFromTheTable) {
+  json control = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "standard",
+      "numerics": {"a_over_dx": 4, "U_inf": 0.03, "immersed_boundary": {"forcing": "control"}}})");
+  EXPECT_THAT(refusal(control),
+              AllOf(HasSubstr("numerics.input_radius"), HasSubstr("docs/coupling.md")));
+  control["numerics"]["input_radius"] = 2.4;
+  EXPECT_THAT(refusal(control), AllOf(HasSubstr("input_radius"), HasSubstr("1.5 dx")));
+  control["numerics"]["input_radius"] = 2.9287;
+  const SuspensionCase c = parse_suspension_case(control);
+  EXPECT_TRUE(c.numerics.coupling.control());
+  EXPECT_EQ(c.numerics.coupling.marker_spacing, 0.7);
+  EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"]["forcing"], "control");
+  EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"]["gains"]["integral"], 2.0);
+
+  const SuspensionCase psm = parse_suspension_case(json::parse(R"({"scene": "suspension",
+      "phi": 0.2, "fidelity": "standard",
+      "numerics": {"a_over_dx": 4, "U_inf": 0.03, "coupling": "partially-saturated"}})"));
+  // nu = U_inf 2a / Re_inf = 0.02: the shipped entry's a_g (3.8958) itself
+  EXPECT_NEAR(psm.numerics.input_radius, 3.8958, 1e-4);
+  EXPECT_EQ(psm.to_json()["numerics"]["coupling"], "partially-saturated");
+  EXPECT_FALSE(psm.to_json()["numerics"].contains("immersed_boundary"));
+}
+
 }  // namespace
 }  // namespace flocsim::cases
