@@ -10,10 +10,12 @@
 //
 //   bench_coupling_noise [--radius A] [--viscosity NU] [--reynolds RE] [--box L]
 //                        [--steps N] [--options OPTION,...] [--series PREFIX]
+//                        [--input-radius AG]
 //
 // For each option (as bench_coupling: direct:KERNEL:SPACING:SWEEPS,
 // control:KERNEL:SPACING[:G:P], psm), with the input radius the shipped
-// calibration gives for a and nu: the sphere is dragged along x, slightly
+// calibration gives for a and nu (or --input-radius, for a scheme not
+// shipped at a): the sphere is dragged along x, slightly
 // off the lattice's axes (U (1, 0.13, 0.07) / |...|), at Re = 2 a U / nu, in
 // an L x L/2 x L/2 box, for N steps. Over the second half it prints the mean
 // drag, its rms fluctuation relative to the mean, and the rms of the part of
@@ -73,7 +75,7 @@ std::optional<coupling::Scheme> parse_option(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double a = 4, nu = 0.02, re = 10;
+  double a = 4, nu = 0.02, re = 10, given_radius = 0;
   int L = 32;
   long steps = 6000;
   std::string options = "direct:roma3:0.7:2,direct:roma3:1:1,control:roma3:0.7,psm", series;
@@ -93,6 +95,8 @@ int main(int argc, char** argv) {
       options = v;
     else if (arg == "--series")
       series = v;
+    else if (arg == "--input-radius")
+      given_radius = std::stod(v);
     else {
       std::fprintf(stderr, "bench_coupling_noise: unknown option %s\n", arg.c_str());
       return 2;
@@ -113,9 +117,9 @@ int main(int argc, char** argv) {
                    text.c_str());
       return 2;
     }
-    double ag = 0;
+    double ag = given_radius;
     try {
-      ag = calibration::CalibrationTable::shipped().input_radius(a, nu, *scheme);
+      if (ag <= 0) ag = calibration::CalibrationTable::shipped().input_radius(a, nu, *scheme);
     } catch (const std::exception& e) {
       std::printf("  %-58s not calibrated at a = %g\n", scheme->describe().c_str(), a);
       continue;
