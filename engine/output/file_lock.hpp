@@ -6,7 +6,8 @@
 // finds its lock file replaced in the meantime locks the new one: only one
 // process ever holds the lock of a path. Combined with write_file_atomically
 // or TemporaryFile, readers see the old or the new file, writers never lose
-// each other's changes.
+// each other's changes. (A lock is shared with a child forked while it is
+// held, as any flock: fork before taking it.)
 #include <filesystem>
 
 namespace flocsim::output {
