@@ -547,12 +547,13 @@ TEST(SuspensionCaseRefusals, NoLubricationModelIsRecordedWhereNoneRuns) {
       EXPECT_EQ(parse_suspension_case(recorded).to_json(), recorded);
       std::string warnings;
       for (const auto& w : c.warnings) warnings += w + "\n";
-      if (d.contains("lubrication_model"))
+      if (d.contains("lubrication_model")) {
         EXPECT_THAT(warnings,
                     AllOf(HasSubstr("lubrication_model"), HasSubstr(scene),
                           HasSubstr("no model runs"), HasSubstr("lubrication_integration")));
-      else
+      } else {
         EXPECT_EQ(warnings.find("lubrication"), std::string::npos) << warnings;
+      }
     }
     // a misspelt model is still refused
     EXPECT_THAT(refusal(with({{"lubrication_model", "calibrate"}})),

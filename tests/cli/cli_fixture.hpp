@@ -2,13 +2,13 @@
 // What the command-line tests share: a fresh folder per test (kept when it
 // fails) and the built flocsim.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "harness.hpp"
+#include "tests/run/scratch_dir.hpp"
 
 namespace flocsim {
 
@@ -17,10 +17,8 @@ namespace t = flocsim::test;
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("flocsim_cli_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
+    dir_ = flocsim::testing::fresh_dir(
+        std::string("cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override {

@@ -18,6 +18,7 @@
 #include "orchestrator/run_selection.hpp"
 #include "orchestrator/sweep.hpp"
 #include "postprocess/tables.hpp"
+#include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::postprocess {
 namespace {
@@ -49,10 +50,9 @@ struct Row {
 class Selection : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("flocsim_selection_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
+    dir_ = flocsim::testing::fresh_dir(
+        std::string("selection_") +
+        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     db_ = (dir_ / "results.db").string();
   }
@@ -240,9 +240,10 @@ TEST_F(Selection, UnreadableRowsAreListedAndNeverShownAsResults) {
   EXPECT_TRUE(non_aggregating_table(runs).empty());
   for (const AggregationRow& row : aggregation_table(runs)) {
     EXPECT_EQ(row.baseline, nullptr) << row.run->id;
-    if (row.run->id == "agg")
+    if (row.run->id == "agg") {
       EXPECT_THAT(row.reason,
                   AllOf(HasSubstr("base"), HasSubstr("cannot be read"), HasSubstr("result_json")));
+    }
   }
 }
 
