@@ -173,7 +173,7 @@ void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
   for (std::size_t k = 1; k < o.gaps.size(); ++k)
     if (!(o.gaps[k] > o.gaps[k - 1]))
       throw input::InputError("--gaps: must increase (the last gives the box offset), got " +
-                              std::to_string(o.gaps[k - 1]) + " then " + std::to_string(o.gaps[k]));
+                              number_text(o.gaps[k - 1]) + " then " + number_text(o.gaps[k]));
   // a sphere's kernel cells must not meet its own periodic image: L > 2 a_g + 3
   // with a_g < a (the immersed boundary refuses it, but only once a run starts)
   if (!o.close_pairs)
