@@ -159,10 +159,10 @@ int run_radius_calibration(const CalibrateOptions& o) {
 // could not write: an option of the other calibration, a table that is not
 // one of this kind or cannot be written (engine/calibration/table_file.hpp).
 void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
-  const char* pair_only[] = {"--separating", "--gaps", "--pair-box", "--input-radius"};
-  const char* radius_only[] = {"--boxes", "--tolerance"};
-  for (const char* name : o.close_pairs ? std::vector<const char*>(radius_only, radius_only + 2)
-                                        : std::vector<const char*>(pair_only, pair_only + 4))
+  const std::vector<const char*> pair_only = {"--separating", "--gaps", "--pair-box",
+                                              "--input-radius"};
+  const std::vector<const char*> radius_only = {"--boxes", "--tolerance", "--grid-offsets"};
+  for (const char* name : o.close_pairs ? radius_only : pair_only)
     if (cmd.get_option(name)->count() > 0)
       throw input::InputError(
           std::string(name) +
@@ -229,12 +229,13 @@ const bool registered = register_command(
            ->check(CLI::IsMember(coupling::forcing_names()));
        cmd.add_option("--gains", o->gains,
                       "control forcing: integral and proportional gain (docs/coupling.md)")
-           ->expected(2);
+           ->expected(2)
+           ->check(finite_number(0.0, 1e6));
        cmd.add_option("--grid-offsets", o->grid_offsets,
                       "run each box with the sphere's centre at floor(L/2) + d for each d (0: on a "
                       "node, 0.5: mid-cell) and average: for schemes whose boundary depends on "
                       "where it sits on the grid (default: centred at L/2, one run)")
-           ->check(CLI::Range(0.0, 1.0));
+           ->check(finite_number(0.0, 1.0));
        cmd.add_option("--tolerance", o->tolerance,
                       "steady state: relative change of U per 100 steps")
            ->check(finite_number(1e-10, 1e-3));

@@ -44,14 +44,19 @@ TEST_F(Calibrate, RefusesNonFiniteNumbersNamingTheOption) {
         {"--radius", "3", "--close-pairs", "--pair-box", "nan"},
         {"--radius", "3", "--viscosity", "inf"},
         {"--radius", "3", "--marker-spacing", "-inf"},
+        {"--radius", "3", "--forcing", "control", "--gains", "nan", "0"},
+        {"--radius", "3", "--grid-offsets", "0", "nan"},
+        {"--radius", "3", "--close-pairs", "--input-radius", "nan"},
         {"--radius", "3", "--close-pairs", "--gaps", "0.1", "nan"}}) {
     std::vector<std::string> args = {"calibrate", "--table", table};
     args.insert(args.end(), bad.begin(), bad.end());
     t::Output o;
     const double s = seconds_of([&] { o = t::run(flocsim(args)); });
-    const std::string option = bad.size() > 2 ? bad[bad.size() - 2] : bad[0];
+    std::string option;  // the last one named: the one given a non-finite value
+    for (const std::string& word : bad)
+      if (word.rfind("--", 0) == 0) option = word;
     SCOPED_TRACE(option);
-    expect_refused_up_front(o, {option == "0.1" ? "--gaps" : option, "finite"}, table, s);
+    expect_refused_up_front(o, {option, "finite"}, table, s);
   }
 }
 
@@ -125,8 +130,10 @@ TEST_F(Calibrate, RefusesOptionsTheCalibrationDoesNotUse) {
   for (const std::vector<std::string>& extra : {std::vector<std::string>{"--separating"},
                                                 {"--gaps", "0.1", "0.5"},
                                                 {"--pair-box", "12"},
+                                                {"--input-radius", "2"},
                                                 {"--close-pairs", "--boxes", "8"},
-                                                {"--close-pairs", "--tolerance", "1e-6"}}) {
+                                                {"--close-pairs", "--tolerance", "1e-6"},
+                                                {"--close-pairs", "--grid-offsets", "0", "0.5"}}) {
     std::vector<std::string> args = {"calibrate", "--table", table, "--radius", "2"};
     args.insert(args.end(), extra.begin(), extra.end());
     t::Output o;
