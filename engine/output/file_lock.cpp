@@ -8,11 +8,16 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 
 namespace flocsim::output {
 
 std::filesystem::path FileLock::lock_file(const std::filesystem::path& path) {
-  return path.parent_path() / ("." + path.filename().string() + ".lock");
+  // appended piece by piece: GCC 12 warns (-Wrestrict, falsely) on "." + string
+  std::string name = ".";
+  name += path.filename().string();
+  name += ".lock";
+  return path.parent_path() / name;
 }
 
 FileLock::FileLock(const std::filesystem::path& path) : lock_path_(lock_file(path)) {
