@@ -123,17 +123,28 @@ std::string scheme_fields(const coupling::Scheme& s,
          field("kernel", coupling::kernel_name(s.kernel)) + "}";
 }
 
+// The case field that names a scheme.
+std::string coupling_field(const coupling::Scheme& s) {
+  return s.immersed_boundary() ? "numerics.immersed_boundary" : "numerics.coupling";
+}
+
 // The refusal of a scheme used beyond the solids fraction it is validated for.
 InputError beyond_validated_phi(const coupling::Scheme& scheme, const nlohmann::json& given,
                                 double phi) {
-  return InputError(
-      "numerics.immersed_boundary = " + scheme_fields(scheme, given) +
-      " with phi = " + format_value(phi) + ": " + std::to_string(scheme.sweeps) + " forcing sweep" +
-      (scheme.sweeps == 1 ? " is" : "s are") +
-      " validated only up to phi = " + format_value(coupling::largest_validated_phi(scheme)) +
-      " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
-      "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
-      "(docs/accuracy-cost.md)");
+  const std::string limit = format_value(coupling::largest_validated_phi(scheme));
+  if (scheme.immersed_boundary() && !scheme.control())
+    return InputError("numerics.immersed_boundary = " + scheme_fields(scheme, given) +
+                      " with phi = " + format_value(phi) + ": " + std::to_string(scheme.sweeps) +
+                      " forcing sweep" + (scheme.sweeps == 1 ? " is" : "s are") +
+                      " validated only up to phi = " + limit +
+                      " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
+                      "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
+                      "(docs/accuracy-cost.md)");
+  return InputError(coupling_field(scheme) + " = " + scheme_fields(scheme, given) +
+                    " with phi = " + format_value(phi) + ": " + scheme.describe() +
+                    " is checked only up to phi = " + limit +
+                    " (docs/coupling.md); use the paper's direct forcing (the default of "
+                    "fidelity \"paper\") above it");
 }
 
 std::string box_text(const std::vector<double>& b) {
@@ -232,7 +243,8 @@ namespace {
 // moving spheres, more than one forcing sweep, a < 6 dx, nu below its floor.
 bool multi_sweep_oscillates(const SuspensionCase& c) {
   return modules_of(c.scene).liquid && modules_of(c.scene).spheres_move &&
-         c.numerics.coupling.sweeps > 1 && c.numerics.radius_cells < 6 &&
+         c.numerics.coupling.immersed_boundary() && c.numerics.coupling.sweeps > 1 &&
+         c.numerics.radius_cells < 6 &&
          c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
 }
 // The U_inf that puts this case's viscosity on that floor.
@@ -482,11 +494,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     }
     if (!offered) refuse_beyond_validated_phi();
     if (!offered)
-      throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling, ib_given) +
-          ": not an offered option (no calibration of it is shipped at any a); "
-          "offered: " +
-          names + " (docs/accuracy-cost.md)");
+      throw InputError(coupling_field(c.numerics.coupling) + " = " +
+                       scheme_fields(c.numerics.coupling, ib_given) +
+                       ": not an offered option (no calibration of it is shipped at any a); "
+                       "offered: " +
+                       names + " (docs/accuracy-cost.md)");
   }
   if (modules_of(c.scene).liquid && !c.numerics.input_radius_given) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
@@ -503,7 +515,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       refuse_beyond_validated_phi();
     if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
       throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling, ib_given) +
+          coupling_field(c.numerics.coupling) + " = " +
+          scheme_fields(c.numerics.coupling, ib_given) +
           ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
           c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
           format_value(a) + " --viscosity NU" +

@@ -671,5 +671,20 @@ TEST(SuspensionCaseCoupling, ControlForcingByHandAndPartiallySaturatedCellsFromT
   EXPECT_FALSE(psm.to_json()["numerics"].contains("immersed_boundary"));
 }
 
+// The multi-sweep coupling's oscillation floor (a < 6, nu < 0.0133) is the
+// immersed boundary's: partially saturated cells have no sweeps, and a case
+// at a viscosity their table holds (0.01 at a = 4) is accepted as given.
+// Above phi = 0.2, where they were not checked, they are refused naming
+// numerics.coupling.
+TEST(SuspensionCaseCoupling, PartiallySaturatedCellsHaveNoSweepFloorAndAPhiLimit) {
+  const SuspensionCase c = parse_suspension_case(json::parse(R"({"scene": "suspension",
+      "phi": 0.2, "fidelity": "draft",
+      "numerics": {"a_over_dx": 4, "viscosity": 0.01, "coupling": "partially-saturated"}})"));
+  EXPECT_DOUBLE_EQ(c.numerics.viscosity, 0.01);
+  EXPECT_THAT(refusal(json::parse(R"({"scene": "suspension", "phi": 0.25, "fidelity": "draft",
+      "numerics": {"a_over_dx": 4, "viscosity": 0.02, "coupling": "partially-saturated"}})")),
+              AllOf(HasSubstr("numerics.coupling"), HasSubstr("phi = 0.2")));
+}
+
 }  // namespace
 }  // namespace flocsim::cases
