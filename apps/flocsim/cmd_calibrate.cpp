@@ -174,20 +174,26 @@ void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
     if (!(o.gaps[k] > o.gaps[k - 1]))
       throw input::InputError("--gaps: must increase (the last gives the box offset), got " +
                               number_text(o.gaps[k - 1]) + " then " + number_text(o.gaps[k]));
-  // a sphere's kernel cells must not meet its own periodic image: L > 2 a_g + 3
-  // with a_g < a (the immersed boundary refuses it, but only once a run starts)
+  // a sphere must not reach its own periodic image: the immersed boundary
+  // needs L > 2 a_g + 3 (its kernel), partially saturated cells
+  // L > 2 (a_g + sqrt(3)/2); checked here for the first pass's a_g = a - 0.3
+  // (the couplings refuse it themselves, but only once a run starts)
   if (!o.close_pairs)
-    for (double a : o.radii)
+    for (double a : o.radii) {
+      const double ag = a - 0.3;
+      const bool markers = o.method == coupling::method_name(coupling::Method::immersed_boundary);
+      const double reach = markers ? 2 * ag + 3 : 2 * (ag + 0.8660254037844386);
       for (int box : boxes_of(o, a))
-        if (box <= 2 * a + 3)
+        if (box <= reach)
           throw input::InputError(
               (o.boxes.empty() ? "the default box " + std::to_string(box) + " (chi = 2a/L of " +
                                      "0.35, 0.5, 0.7)"
                                : "--boxes " + std::to_string(box)) +
-              " for --radius " + number_text(a) +
-              ": a cube must exceed 2a + 3 = " + number_text(2 * a + 3) +
-              " dx (the sphere's kernel must not meet its own periodic image); give --boxes "
-              "with larger edges");
+              " for --radius " + number_text(a) + ": a cube must exceed " +
+              (markers ? "2 a_g + 3 = " : "2 (a_g + sqrt(3)/2) = ") + number_text(reach) +
+              " dx with the first input radius tried, a_g = a - 0.3 (a sphere must not reach its "
+              "own periodic image); give --boxes with larger edges");
+    }
   calibration::check_table_file(o.table, o.close_pairs
                                              ? calibration::TableKind::close_pair
                                              : calibration::TableKind::hydrodynamic_radius);

@@ -146,10 +146,18 @@ TEST_F(Calibrate, RefusesOptionsTheCalibrationDoesNotUse) {
   double s = seconds_of([&] {
     o = t::run(flocsim({"calibrate", "--table", table, "--radius", "3", "--boxes", "8"}));
   });
-  expect_refused_up_front(o, {"--boxes 8", "--radius 3", "must exceed 2a + 3 = 9"}, table, s);
+  expect_refused_up_front(o, {"--boxes 8", "--radius 3", "must exceed 2 a_g + 3 = 8.4"}, table, s);
   s = seconds_of([&] { o = t::run(flocsim({"calibrate", "--table", table, "--radius", "2"})); });
-  expect_refused_up_front(o, {"the default box 6", "--radius 2", "must exceed 2a + 3 = 7"}, table,
-                          s);
+  expect_refused_up_front(o, {"the default box 6", "--radius 2", "must exceed 2 a_g + 3 = 6.4"},
+                          table, s);
+  // the default boxes at a = 4 (16, 11: what the shipped a = 4 entries used)
+  // pass this check: the refusal is then the table's, in a missing folder
+  s = seconds_of([&] {
+    o = t::run(
+        flocsim({"calibrate", "--table", (dir_ / "no" / "t.json").string(), "--radius", "4"}));
+  });
+  EXPECT_THAT(o.out, ::testing::Not(HasSubstr("must exceed")));
+  EXPECT_NE(o.code, 0);
 }
 
 // Two calibrations into one table, the first paused while the second
