@@ -147,6 +147,19 @@ int run_radius_calibration(const CalibrateOptions& o) {
       spread = std::max(spread, std::abs(radius - a));
     std::printf("=> a_g = %.4f for a = %g (largest box deviation %.4f dx)\n", entry.input_radius, a,
                 spread);
+    // the passes stop when the boxes' mean radius is within 0.01 dx of a, or
+    // after six; a table entry that missed is kept (the work is not lost) but
+    // said to be unconverged, so nobody ships it by mistake
+    double mean = 0;
+    for (const auto& [box, radius] : entry.box_radii()) mean += radius;
+    mean /= static_cast<double>(entry.box_radii().size());
+    if (std::abs(mean - a) > 0.01)
+      std::fprintf(stderr,
+                   "flocsim calibrate: warning: not converged for a = %g: after six passes the "
+                   "boxes' mean radius is %.4f (%+.4f dx from a, more than 0.01); the entry is "
+                   "written with the last a_g but should not be shipped: rerun, or give --boxes "
+                   "or --grid-offsets\n",
+                   a, mean, mean - a);
     // after every radius, so a long calibration keeps what it has; under the
     // table's lock, with what other calibrations added meanwhile
     calibration::add_to_table_file(o.table, entry, note);
