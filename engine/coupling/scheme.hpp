@@ -146,7 +146,7 @@ struct Scheme {
            kernel == o.kernel && forcing == o.forcing;
   }
   // "markers 0.7 dx apart, 2 sweeps, roma3 kernel"; "markers 0.7 dx apart,
-  // control forcing (gains 0.5, 0), roma3 kernel"; "partially saturated cells"
+  // control forcing (gains 2, 0), roma3 kernel"; "partially saturated cells"
   std::string describe() const {
     if (!immersed_boundary()) return "partially saturated cells";
     char spacing[32];
