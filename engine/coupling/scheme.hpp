@@ -145,7 +145,7 @@ struct Scheme {
     return std::abs(marker_spacing - o.marker_spacing) <= 1e-9 && sweeps == o.sweeps &&
            kernel == o.kernel && forcing == o.forcing;
   }
-  // "markers 0.7 dx apart, 2 sweeps, roma3 kernel"; "markers 0.7 dx apart,
+  // "markers 0.7 dx apart, 2 sweeps, roma3 kernel"; "markers 1 dx apart,
   // control forcing (gains 2, 0), roma3 kernel"; "partially saturated cells"
   std::string describe() const {
     if (!immersed_boundary()) return "partially saturated cells";
