@@ -91,6 +91,17 @@ TEST(SuspensionCase, EachPresetHasItsSettlingVelocity) {
     EXPECT_DOUBLE_EQ(c.derived.settling_velocity, w.u);
     EXPECT_NEAR(c.numerics.viscosity, w.nu, 1e-15);
     EXPECT_NEAR(c.derived.convective_time, w.steps, 1e-12);
+    // A scene without liquid has no Mach number to trade: U_inf sets only its
+    // time unit and its start, Maxwellian with U_inf per component, whose tail
+    // must stay below the sphere speed check (0.3 per step). At draft's 0.07
+    // a granular gas of 61 spheres with a strong well tripped it (0.36, about
+    // 5 U_inf, within 10 a/U_inf), so it keeps 0.02 at every preset.
+    const SuspensionCase gas = parse_suspension_case({{"scene", "granular"},
+                                                      {"fidelity", w.fidelity},
+                                                      {"phi", 0.25},
+                                                      {"Re_inf", 12},
+                                                      {"du_over_Uinf", 0.5}});
+    EXPECT_DOUBLE_EQ(gas.derived.settling_velocity, 0.02);
   }
 }
 
@@ -165,6 +176,13 @@ TEST(SuspensionCase, MachLimitIsStatedWhenBroken) {
   at_limit["numerics"]["U_inf"] = 0.0701;
   EXPECT_THAT(refusal(at_limit),
               AllOf(HasSubstr("numerics.U_inf = 0.0701"), HasSubstr("<= 0.07"), HasSubstr("Mach")));
+  // without liquid there is no Mach number, but the sphere speed check (0.3
+  // per step) must stay 6 U_inf out in the Maxwellian start: U_inf <= 0.05
+  json gas = {{"scene", "granular"}, {"phi", 0.2}, {"numerics", {{"U_inf", 0.05}}}};
+  EXPECT_DOUBLE_EQ(parse_suspension_case(gas).derived.settling_velocity, 0.05);
+  gas["numerics"]["U_inf"] = 0.06;
+  EXPECT_THAT(refusal(gas), AllOf(HasSubstr("numerics.U_inf = 0.06"), HasSubstr("<= 0.05"),
+                                  HasSubstr("sphere speed check")));
 }
 
 TEST(SuspensionCase, BadInputsAreNamed) {
