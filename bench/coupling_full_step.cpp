@@ -88,7 +88,7 @@ struct Option {
 int main(int argc, char** argv) {
   double scale = 1, phi = 0.20;
   int reps = 5, steps = 4;
-  std::string options_text = "direct:roma3:0.7:2,direct:roma3:1:1,control:roma3:0.7,psm";
+  std::string options_text = "direct:roma3:0.7:2,direct:roma3:1:1,control:roma3:1,psm";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (i + 1 >= argc) {

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   bool held = false;
   int L = 32;
   long steps = 6000;
-  std::string options = "direct:roma3:0.7:2,direct:roma3:1:1,control:roma3:0.7,psm", series;
+  std::string options = "direct:roma3:0.7:2,direct:roma3:1:1,control:roma3:1,psm", series;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], v = argv[i + 1];
     if (arg == "--radius")

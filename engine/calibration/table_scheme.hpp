@@ -56,7 +56,7 @@ inline void write_scheme(nlohmann::json& entry, const coupling::Scheme& scheme) 
 }
 
 // The `flocsim calibrate` options that name this scheme: " --marker-spacing 1
-// --sweeps 1 --kernel roma3", " --forcing control --marker-spacing 0.7
+// --sweeps 1 --kernel roma3", " --forcing control --marker-spacing 1
 // --kernel roma3", " --coupling partially-saturated".
 inline std::string calibrate_options(const coupling::Scheme& scheme) {
   if (!scheme.immersed_boundary()) return " --coupling " + coupling::method_name(scheme.method);

@@ -73,7 +73,7 @@ Preset preset(const std::string& fidelity) {
 // "partially-saturated") and, for the immersed boundary,
 // numerics.immersed_boundary: {"marker_spacing", "sweeps", "kernel",
 // "forcing", "gains"}, each defaulting to the preset's value (control forcing:
-// to the paper's markers, 0.7 dx, and the measured default gains).
+// to markers 1 dx apart and the measured default gains).
 coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& preset_scheme) {
   const std::string method = numerics.choice("coupling", coupling::method_names(),
                                              coupling::method_name(preset_scheme.method));
@@ -102,7 +102,7 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
           " with control forcing: must be >= " +
           format_value(coupling::kSmallestControlMarkerSpacing) +
           " (with markers closer than the lattice spacing a sphere moving through the liquid "
-          "feels 0.78-0.86 of the drag it feels held, at 1 dx 0.995; docs/coupling.md)");
+          "feels 0.78-0.85 of the drag it feels held, at 1 dx 0.995-1.0005; docs/coupling.md)");
     if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
       throw InputError(
           "numerics.immersed_boundary.sweeps: control forcing makes one correction "

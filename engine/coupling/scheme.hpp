@@ -179,7 +179,7 @@ inline constexpr Scheme kOneSweepScheme{1.0, 1, Kernel::roma3};
 
 // The paper's own forcing, control forcing, with markers 1 dx apart. Not the
 // paper's 0.7 dx: with markers denser than the lattice a sphere dragged
-// through the liquid feels 0.78-0.86 of the drag it feels held (nu 0.1-0.02,
+// through the liquid feels 0.78-0.85 of the drag it feels held (nu 0.1-0.02,
 // Re 1), at 1 dx apart 0.995 and at 1.2 dx 1.000 (docs/coupling.md,
 // "Galilean invariance"). The likely reason: closer than dx the markers'
 // slips are not independent (more markers than cells under their kernels),

@@ -108,7 +108,7 @@ TEST(GalileanInvariance, DraggedAndHeldSpheresFeelTheSameDrag) {
 }
 
 // Why control forcing refuses markers closer than 1 dx: at the paper's
-// 0.7 dx a dragged sphere feels 14-22 % less drag than a held one (0.83
+// 0.7 dx a dragged sphere feels 15-22 % less drag than a held one (0.83
 // here; 0.78 and 0.85 in bench_coupling_noise at nu 0.1 and 0.02,
 // docs/coupling.md), with the gains and kernel that are invariant to 0.4 % at
 // 1 dx above.

@@ -17,7 +17,7 @@ using spheres::Vec3;
 // nu = 0.005; cases offer it at a = 4, where the floor is 0.01), a sphere settling at Re 12 for 1e5
 // steps with the default gains and at the two edges of the accepted region (integral 3; integral 1
 // with proportional 1): bounded, the marker slip below 1e-2 U
-// (docs/coupling.md: 6e-4 measured with the defaults). About 2 minutes per
+// (1.2e-4 measured with the defaults, docs/coupling.md). About 2 minutes per
 // gain on one core.
 TEST(ControlForcingSlow, SettlingSphereStaysBoundedFor1e5StepsAtTheLowestViscosity) {
   for (const coupling::ControlGains g : {coupling::ControlGains{2, 0}, {3, 0}, {1, 1}}) {
