@@ -4,6 +4,7 @@
 //
 //   bench_control_stability --input-radius AG --viscosities NU,... --gains G:P,...
 //                           [--box L] [--steps N] [--mode fixed|settling] [--reynolds RE]
+//                           [--marker-spacing S]
 //
 // fixed: the sphere held at rest (off the lattice's symmetry planes), the
 // liquid driven past it by a body force that a sphere of radius a_g would
@@ -52,9 +53,10 @@ struct Outcome {
 };
 
 Outcome run(double ag, double nu, coupling::ControlGains gains, int L, long steps, bool settling,
-            double reynolds) {
+            double reynolds, double spacing) {
   coupling::Scheme scheme = coupling::kControlScheme;
   scheme.gains = gains;
+  scheme.marker_spacing = spacing;
   lattice::FluidLattice<float> fluid({L, L, L}, {nu, 0.25});
   immersed_boundary::ImmersedBoundary<float> ib({ag, scheme, true});
   spheres::SphereSet s;
@@ -108,7 +110,7 @@ Outcome run(double ag, double nu, coupling::ControlGains gains, int L, long step
 }  // namespace
 
 int main(int argc, char** argv) {
-  double ag = 3.5, reynolds = 1.0;
+  double ag = 3.5, reynolds = 1.0, spacing = coupling::kControlScheme.marker_spacing;
   int L = 24;
   long steps = 100000;
   std::string viscosities = "0.01", gains_text = "0.5:0", mode = "fixed";
@@ -128,6 +130,8 @@ int main(int argc, char** argv) {
       mode = v;
     else if (arg == "--reynolds")
       reynolds = std::stod(v);
+    else if (arg == "--marker-spacing")
+      spacing = std::stod(v);
     else {
       std::fprintf(stderr, "bench_control_stability: unknown option %s\n", arg.c_str());
       return 2;
@@ -151,7 +155,7 @@ int main(int argc, char** argv) {
       const auto gp = split(g, ':');
       const double nu = std::stod(nu_text);
       const coupling::ControlGains gains{std::stod(gp.at(0)), gp.size() > 1 ? std::stod(gp[1]) : 0};
-      const Outcome o = run(ag, nu, gains, L, steps, mode == "settling", reynolds);
+      const Outcome o = run(ag, nu, gains, L, steps, mode == "settling", reynolds, spacing);
       std::printf("  %8g %6g %6g %8ld %8s %10.3e %9.4f %8.4f\n", nu, gains.integral,
                   gains.proportional, o.steps, o.bounded ? "yes" : "NO", o.slip_end, o.growth,
                   o.load);

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/coupling_options.hpp"
 #include "bench/memory_bandwidth.hpp"
 #include "engine/coupling/scheme.hpp"
 #include "engine/coupling_schemes/make_coupling.hpp"
@@ -72,39 +73,6 @@ std::vector<Vec3> random_positions(std::size_t n, double a, const spheres::Perio
     if (ok) out.push_back(x);
   }
   return out;
-}
-
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  for (std::string p; std::getline(in, p, sep);) parts.push_back(p);
-  return parts;
-}
-
-// One option of --options -> Scheme; nullopt when malformed.
-std::optional<coupling::Scheme> parse_option(const std::string& text) {
-  if (text == "psm") return coupling::kPartiallySaturatedScheme;
-  auto parts = split(text, ':');
-  coupling::Scheme s;
-  if (!parts.empty() && (parts[0] == "direct" || parts[0] == "control")) {
-    s.forcing = *coupling::forcing_from_name(parts[0]);
-    parts.erase(parts.begin());
-  }
-  const std::size_t wanted = s.control() ? 2 : 3;
-  if (parts.size() != wanted && !(s.control() && parts.size() == 4)) return std::nullopt;
-  const auto kernel = coupling::kernel_from_name(parts[0]);
-  if (!kernel) return std::nullopt;
-  s.kernel = *kernel;
-  try {
-    s.marker_spacing = std::stod(parts[1]);
-    s.sweeps = s.control() ? 1 : std::stoi(parts[2]);
-    if (s.control() && parts.size() == 4) s.gains = {std::stod(parts[2]), std::stod(parts[3])};
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (!(s.marker_spacing >= 0.3 && s.marker_spacing <= 1.5) || s.sweeps < 1 || s.sweeps > 20)
-    return std::nullopt;
-  return s;
 }
 
 struct Option {
@@ -146,14 +114,11 @@ int main(int argc, char** argv) {
     }
   }
   std::vector<Option> options;
-  for (const std::string& one : split(options_text, ',')) {
-    const auto scheme = parse_option(one);
+  for (const std::string& one : bench::split(options_text, ',')) {
+    const auto scheme = bench::parse_option(one);
     if (!scheme) {
-      std::fprintf(stderr,
-                   "bench_coupling: --options entry '%s': expected psm, "
-                   "direct:KERNEL:SPACING:SWEEPS or control:KERNEL:SPACING[:G:P] with kernel "
-                   "roma3 or linear2, spacing in [0.3, 1.5] dx, sweeps in [1, 20]\n",
-                   one.c_str());
+      std::fprintf(stderr, "bench_coupling: --options entry '%s': expected %s\n", one.c_str(),
+                   bench::kOptionsSyntax);
       return 2;
     }
     options.push_back(Option{*scheme, {}, {}, {}, {}, {}, {}, {}, {}});

@@ -39,28 +39,6 @@ std::string format_with_error(double mean, std::optional<double> error,
   return buf;
 }
 
-Filter parse_filter(const std::string& text) {
-  static const char* ops[] = {"!=", "<=", ">=", "==", "=", "<", ">"};
-  for (std::size_t pos = 0; pos < text.size(); ++pos)
-    for (const char* op : ops) {
-      const std::string o(op);
-      if (text.compare(pos, o.size(), o) == 0) {
-        Filter f{text.substr(0, pos), o == "==" ? "=" : o, text.substr(pos + o.size())};
-        auto trim = [](std::string& s) {
-          s.erase(0, s.find_first_not_of(" \t"));
-          s.erase(s.find_last_not_of(" \t") + 1);
-        };
-        trim(f.field);
-        trim(f.value);
-        if (f.field.empty() || f.value.empty()) break;
-        return f;
-      }
-    }
-  throw InputError("--where \"" + text +
-                   "\": expected FIELD OP VALUE with OP one of = != < <= > >= "
-                   "(e.g. --where phi=0.2 --where 'F>10' --where status=completed)");
-}
-
 namespace {
 
 std::string format_number(double v) {
@@ -82,92 +60,6 @@ struct Table {
   std::vector<std::map<std::string, json>> rows;  // column -> value (null when absent)
 };
 
-// Rows: every run of the chosen sweep(s), with axes, result and observables.
-Table build_table(db::ResultsDb& db, const QueryOptions& o, std::vector<json>* cases) {
-  std::vector<db::SweepRecord> sweeps;
-  if (o.sweep) {
-    auto s = db.find_sweep(*o.sweep);
-    if (!s) {
-      std::string known;
-      for (const auto& k : db.sweeps()) known += (known.empty() ? "" : ", ") + k.name;
-      throw InputError("--sweep " + *o.sweep + ": no such sweep in " + db.path() +
-                       " (known: " + (known.empty() ? "none" : known) + ")");
-    }
-    sweeps.push_back(*s);
-  } else {
-    sweeps = db.sweeps();
-  }
-  Table t;
-  t.columns = {"run", "sweep", "status"};
-  std::vector<std::string> axes, observables;
-  std::set<std::string> seen_runs;
-  for (const db::SweepRecord& s : sweeps) {
-    for (const json& a : json::parse(s.axes_json))
-      if (std::find(axes.begin(), axes.end(), a.get<std::string>()) == axes.end())
-        axes.push_back(a.get<std::string>());
-  }
-  for (const db::SweepRecord& s : sweeps) {
-    for (db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
-      if (!seen_runs.insert(r.run.id).second) continue;  // shared by two sweeps: list once
-      std::map<std::string, json> row;
-      const json c = json::parse(r.run.case_json);
-      row["run"] = r.run.id.substr(0, 12);
-      row["sweep"] = s.name;
-      row["status"] = to_string(r.run.status);
-      for (const std::string& a : axes) row[a] = get_path(c, a).value_or(json());
-      for (const db::Observable& ob : r.observables) {
-        if (std::find(observables.begin(), observables.end(), ob.name) == observables.end())
-          observables.push_back(ob.name);
-        row[ob.name] = ob.mean;
-        row[ob.name + "_err"] = ob.error ? json(*ob.error) : json();
-      }
-      // short marks for the terminal table: s = a window still drifts, u = an
-      // error is not reliable (result.json's verdicts)
-      std::string flags;
-      if (!r.result_json.empty()) {
-        const json res = json::parse(r.result_json, nullptr, false);
-        if (res.is_object()) {
-          if (!res.value("not_stationary", json::array()).empty()) flags += "s";
-          const json measured = res.value("observables", json::object());
-          for (const auto& entry : measured.items())
-            if (entry.value().is_object() && !entry.value().value("error_reliable", true) &&
-                flags.find('u') == std::string::npos)
-              flags += "u";
-        }
-      }
-      row["flags"] = flags;
-      row["wall_s"] = r.wall_s ? json(*r.wall_s) : json();
-      row["mlups"] = r.mlups ? json(*r.mlups) : json();
-      row["attempts"] = r.run.attempts;
-      row["error"] = r.run.error;
-      t.rows.push_back(std::move(row));
-      if (cases) cases->push_back(c);
-    }
-  }
-  for (const std::string& a : axes) t.columns.push_back(a);
-  t.axes = axes;
-  for (const std::string& ob : observables) {
-    t.columns.push_back(ob);
-    t.columns.push_back(ob + "_err");
-  }
-  for (const char* c : {"wall_s", "mlups", "attempts"}) t.columns.push_back(c);
-  return t;
-}
-
-bool as_number(const json& v, double& out) {
-  if (v.is_number()) {
-    out = v.get<double>();
-    return true;
-  }
-  if (v.is_string()) {
-    const std::string s = v.get<std::string>();
-    char* end = nullptr;
-    out = std::strtod(s.c_str(), &end);
-    return !s.empty() && end == s.c_str() + s.size();
-  }
-  return false;
-}
-
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -180,72 +72,21 @@ std::string csv_field(const std::string& s) {
 
 }  // namespace
 
-bool filter_matches(const json& v, const Filter& f) {
-  if (v.is_null()) return false;
-  double a = 0, b = 0;
-  if (as_number(v, a) && as_number(json(f.value), b)) {
-    // Equality tolerates the last digits lost in printing (0.1+0.2 vs 0.3).
-    const bool eq = std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b));
-    if (f.op == "=") return eq;
-    if (f.op == "!=") return !eq;
-    if (f.op == "<") return a < b && !eq;
-    if (f.op == "<=") return a < b || eq;
-    if (f.op == ">") return a > b && !eq;
-    return a > b || eq;
-  }
-  const std::string s = v.is_string() ? v.get<std::string>() : v.dump();
-  if (f.op == "=") return s == f.value;
-  if (f.op == "!=") return s != f.value;
-  if (f.op == "<") return s < f.value;
-  if (f.op == "<=") return s <= f.value;
-  if (f.op == ">") return s > f.value;
-  return s >= f.value;
-}
-
 int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
   if (o.format != "table" && o.format != "csv" && o.format != "json")
     throw InputError("--format " + o.format + ": must be one of table, csv, json");
+  // the runs and the filters shared with `flocsim post`
+  RunSelection selection = select_runs(db, o.sweep, o.where);
+  if (o.left_out)
+    for (const DamagedRun& d : selection.damaged)
+      *o.left_out << "left out, unreadable: " << d.text() << "\n";
+  Table t{selection.columns, selection.axes, {}};
   std::vector<json> cases;
-  Table t = build_table(db, o, &cases);
-  // Filters: a column, or else a dotted path into the case.
-  for (const Filter& f : o.where) {
-    const bool is_column =
-        std::find(t.columns.begin(), t.columns.end(), f.field) != t.columns.end() ||
-        f.field == "error";
-    bool known = is_column;
-    for (const json& c : cases) known = known || get_path(c, f.field).has_value();
-    if (!known && !t.rows.empty()) {
-      std::string cols;
-      for (const auto& c : t.columns) cols += (cols.empty() ? "" : ", ") + c;
-      throw InputError("--where " + f.field + f.op + f.value + ": no column or case field \"" +
-                       f.field + "\" (columns: " + cols + "; or a dotted case path)");
-    }
+  for (RunView& r : selection.runs) {
+    t.rows.push_back(std::move(r.columns));
+    cases.push_back(std::move(r.input_case));
   }
-  // A numeric field against a value that is not a number would compare as
-  // text (every row "matches" 'nu<abc'): refuse it.
-  for (const Filter& f : o.where) {
-    double number = 0;
-    if (as_number(json(f.value), number)) continue;
-    for (std::size_t i = 0; i < t.rows.size(); ++i) {
-      auto it = t.rows[i].find(f.field);
-      const json v =
-          it != t.rows[i].end() ? it->second : get_path(cases[i], f.field).value_or(json());
-      if (v.is_number())
-        throw InputError("--where " + f.field + f.op + f.value + ": " + f.field +
-                         " is a number, \"" + f.value +
-                         "\" is not; give a number (e.g. 0.02 or 2e-2)");
-    }
-  }
-  std::vector<std::size_t> keep;
-  for (std::size_t i = 0; i < t.rows.size(); ++i) {
-    bool ok = true;
-    for (const Filter& f : o.where) {
-      auto it = t.rows[i].find(f.field);
-      json v = it != t.rows[i].end() ? it->second : get_path(cases[i], f.field).value_or(json());
-      ok = ok && filter_matches(v, f);
-    }
-    if (ok) keep.push_back(i);
-  }
+  const std::vector<std::size_t>& keep = selection.selected;
   // Columns no kept row fills (observables of other scenes) are left out.
   std::vector<std::string> cols;
   for (const std::string& c : t.columns) {
@@ -344,7 +185,11 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
     table.push_back(std::move(col));
   }
   const std::vector<std::string> left_out = write_fitted(table, o.width, out);
-  out << "(" << keep.size() << " of " << t.rows.size() << " runs)\n";
+  out << "(" << keep.size() << " of " << t.rows.size() << " runs";
+  if (!selection.damaged.empty())
+    out << "; " << selection.damaged.size() << " unreadable row"
+        << (selection.damaged.size() > 1 ? "s" : "") << " left out";
+  out << ")\n";
   if (any_flags && std::find(shown.begin(), shown.end(), "flags") != shown.end())
     out << "flags: s = a window still drifts (not stationary), u = an error is not reliable "
            "(`--format json` has the details)\n";

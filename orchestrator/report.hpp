@@ -1,5 +1,6 @@
 #pragma once
-// What `flocsim query` and `flocsim sweep status` print.
+// What `flocsim query` and `flocsim sweep status` print. The runs a query
+// lists and its filters are run_selection.hpp's, shared with `flocsim post`.
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
@@ -7,21 +8,9 @@
 #include <vector>
 
 #include "db/results_db.hpp"
+#include "orchestrator/run_selection.hpp"
 
 namespace flocsim::orchestrator {
-
-// One filter of `--where`: FIELD OP VALUE with OP one of = != < <= > >=.
-// FIELD is a column of the query (run, status, an axis, an observable, NAME_err,
-// wall_s, mlups, steps, attempts) or any dotted path into the case
-// ("fluid.size", "run.steps"). Numbers compare as numbers, anything else as text.
-struct Filter {
-  std::string field, op, value;
-};
-// Parses "phi>=0.2"; throws flocsim::input::InputError with the accepted forms.
-Filter parse_filter(const std::string& text);
-// Whether a value (a number, or text) satisfies the filter; numbers compare as
-// numbers, with equality to the last printed digits. Null never matches.
-bool filter_matches(const nlohmann::json& value, const Filter& filter);
 
 // A mean shown to the precision its standard error supports: the error
 // rounded to one significant digit and the mean to the same decimal place,
@@ -42,6 +31,9 @@ struct QueryOptions {
   std::vector<std::string> columns;
   // table: fit this many characters, leaving out the last columns (0: no limit)
   std::size_t width = 0;
+  // Where the rows left out as unreadable are listed (run, field, what is
+  // wrong); the table's last line counts them.
+  std::ostream* left_out = nullptr;
 };
 
 // Runs the query and writes it to `out`; returns the number of rows written.

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "engine/input/input_reader.hpp"
 #include "engine/process/exit_codes.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
@@ -133,6 +134,11 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
     std::ofstream(job_dir / ("task_" + std::to_string(tasks) + ".json")) << task.dump(2) << "\n";
   }
   const fs::path script = job_dir / "job.sh";
+  // a #SBATCH line ends at a line break: none may come from a path or a name
+  for (const std::string& v : {sweep.name, job_dir.string(), partition, time_limit})
+    if (v.find_first_of("\n\r") != std::string::npos)
+      throw std::runtime_error("cannot write a Slurm job script with a line break in " +
+                               flocsim::input::shown(v));
   {
     std::ofstream f(script);
     f << "#!/bin/sh\n"

@@ -179,7 +179,7 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
   try {
     flocsim::input::InputReader in(s.source, "");
     s.name = in.text("name");
-    if (s.name.empty() || s.name.find_first_of(" \t\n/\\") != std::string::npos)
+    if (s.name.empty() || s.name.find_first_of(" \t\n\r\v\f/\\") != std::string::npos)
       throw InputError("name = \"" + s.name +
                        "\": must be a non-empty word without spaces or slashes");
     s.description = in.text("description", "");
@@ -193,6 +193,15 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
         static_cast<int>(slurm.integer("runs_per_task", {.at_least = 1, .at_most = 10000}, 1));
     s.slurm.time_limit = slurm.text("time_limit", "01:00:00");
     s.slurm.partition = slurm.text("partition", "");
+    // both go into the job script's #SBATCH lines: one word each, so that no
+    // value can end a line and start a shell command there
+    for (const auto& [field, value] :
+         {std::pair<std::string, std::string>{"slurm.time_limit", s.slurm.time_limit},
+          {"slurm.partition", s.slurm.partition}})
+      if (value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                  "0123456789:-_.,") != std::string::npos)
+        throw InputError(field + " = " + flocsim::input::shown(value) +
+                         ": must be one word of letters, digits and : - _ . , (Slurm's syntax)");
     s.slurm.max_parallel =
         static_cast<int>(slurm.integer("max_parallel", {.at_least = 0, .at_most = 100000}, 0));
     s.slurm.cpus_per_task =

@@ -1,9 +1,16 @@
 #include "postprocess/figures.hpp"
 
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -30,17 +37,57 @@ std::string label(double phi, double re_inf) {
   return "phi" + num(phi) + "_Re" + num(re_inf);
 }
 
+// A file name part from anything (a run id read from the database): only
+// letters, digits and . _ + -, so that a gnuplot script can quote it as it is.
+std::string file_part(const std::string& text) {
+  std::string out = text;
+  for (char& ch : out)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '+' &&
+        ch != '-')
+      ch = '_';
+  return out;
+}
+
+// Runs `gnuplot SCRIPT` in `dir` with its output in `log`, without a shell:
+// no path or name ever reaches a command line that a shell would read. The
+// exit status; 127 when gnuplot cannot be started.
+int run_gnuplot(const fs::path& dir, const std::string& script, const fs::path& log) {
+  const std::string log_path = log.string(), dir_path = dir.string();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("cannot start gnuplot: ") + strerror(errno));
+  if (pid == 0) {
+    const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, STDOUT_FILENO);
+      dup2(fd, STDERR_FILENO);
+      close(fd);
+    }
+    if (chdir(dir_path.c_str()) != 0) _exit(127);
+    char* const argv[] = {const_cast<char*>("gnuplot"), const_cast<char*>(script.c_str()), nullptr};
+    execvp("gnuplot", argv);
+    const char* why = "gnuplot: cannot be started (not found on PATH?)\n";
+    [[maybe_unused]] const auto n = write(STDERR_FILENO, why, strlen(why));
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: ") + strerror(errno));
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
 // One figure under construction: its data blocks and gnuplot commands.
 class Plot {
  public:
   Plot(const fs::path& dir, std::string name, std::string caption)
       : dir_(dir), name_(std::move(name)), caption_(std::move(caption)) {}
-  // Writes a data file and returns its path as gnuplot should quote it.
+  // Writes a data file and returns its path as gnuplot should quote it:
+  // relative to the figures folder, where gnuplot runs, so that neither the
+  // folder's name nor anything read from the database enters the script.
   std::string data(const std::string& tag, const std::string& rows) {
     fs::create_directories(dir_ / "data");
-    const fs::path p = dir_ / "data" / (name_ + (tag.empty() ? "" : "_" + tag) + ".dat");
-    std::ofstream(p) << rows;
-    return "'" + p.string() + "'";
+    const std::string file = file_part(name_ + (tag.empty() ? "" : "_" + tag)) + ".dat";
+    std::ofstream(dir_ / "data" / file) << rows;
+    return "'data/" + file + "'";
   }
   std::ostringstream& commands() { return commands_; }
   // Records a run whose data the figure draws (each once, in order).
@@ -65,17 +112,18 @@ class Plot {
             : "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
     // The commands once per terminal, from a reset state, not replot: gnuplot 5.4's replot
     // after a multiplot redraws only its last panel.
+    // (run in the figures folder: `cd figures && gnuplot scripts/NAME.gp` redraws)
     std::ofstream(script) << "set terminal pngcairo size " << size_png
-                          << " enhanced font 'sans,11'\nset output '" << f.png.string() << "'\n"
+                          << " enhanced font 'sans,11'\nset output '" << f.png.filename().string()
+                          << "'\n"
                           << offsets << commands_.str() << "\nunset output\nreset\n"
                           << "set terminal pdfcairo size " << size_pdf
-                          << " enhanced font 'sans,9'\nset output '" << f.pdf.string() << "'\n"
+                          << " enhanced font 'sans,9'\nset output '" << f.pdf.filename().string()
+                          << "'\n"
                           << offsets << commands_.str() << "\nunset output\n";
-    const std::string cmd = "gnuplot '" + script.string() + "' > '" +
-                            (dir_ / "scripts" / (name_ + ".log")).string() + "' 2>&1";
-    if (std::system(cmd.c_str()) != 0)
-      throw std::runtime_error("gnuplot failed on figure " + name_ + "; see " +
-                               (dir_ / "scripts" / (name_ + ".log")).string());
+    const fs::path log = dir_ / "scripts" / (name_ + ".log");
+    if (run_gnuplot(dir_, "scripts/" + name_ + ".gp", log) != 0)
+      throw std::runtime_error("gnuplot failed on figure " + name_ + "; see " + log.string());
     return f;
   }
 
@@ -125,9 +173,24 @@ const char* kPoint = "with yerrorbars pt 7 ps 1.2";
 
 }  // namespace
 
+std::string why_no_figures() {
+  // where execvp looks (its default search path when PATH is unset)
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "/bin:/usr/bin");
+  for (std::string d; std::getline(dirs, d, ':');)
+    if (access((fs::path(d.empty() ? "." : d) / "gnuplot").c_str(), X_OK) == 0) return "";
+  return "gnuplot, which draws them, is not on PATH (" + std::string(path ? path : "unset") +
+         "); install gnuplot (5.2 or later, with the cairo "
+         "terminals) and run flocsim post figures again";
+}
+
 FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir) {
-  fs::create_directories(dir);
   FigureSet set;
+  if (const std::string why = why_no_figures(); !why.empty()) {
+    set.skipped.push_back("every figure: " + why);
+    return set;
+  }
+  fs::create_directories(dir);
   std::vector<const RunSummary*> done;
   for (const RunSummary& r : runs)
     if (r.status == db::RunState::kCompleted && r.F && r.Re) done.push_back(&r);

@@ -25,8 +25,13 @@ struct FigureSet {
   std::vector<std::string> skipped;  // "name: reason"
 };
 
-// Writes every figure the runs have data for into `dir`. Throws
-// std::runtime_error naming the figure when gnuplot fails.
+// Why no figure can be drawn here (gnuplot is not on PATH), empty when they can.
+std::string why_no_figures();
+
+// Writes every figure the runs have data for into `dir`; without gnuplot none,
+// with the reason in `skipped`. gnuplot runs without a shell, in `dir`, on the
+// scripts it keeps there. Throws std::runtime_error naming the figure when
+// gnuplot fails.
 FigureSet write_figures(const std::vector<RunSummary>& runs, const std::filesystem::path& dir);
 
 }  // namespace flocsim::postprocess

@@ -319,7 +319,8 @@ const char* kStyle =
 }  // namespace
 
 void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
-                  const std::string& database, const std::filesystem::path& file) {
+                  const std::string& database, const std::filesystem::path& file,
+                  const std::vector<std::string>& left_out) {
   const std::vector<AggregationRow> agg = aggregation_table(runs);
   const std::vector<NonAggregatingRow> non = non_aggregating_table(runs);
   std::ostringstream h;
@@ -334,6 +335,8 @@ void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
        "case. Flags: <span class='flag'>u</span> errors not reliable, <span class='flag'>s</span> "
        "a window still drifts (not stationary), <span class='flag'>b</span> no F/F<sub>0</sub>; "
        "hover over a flag, a cut value or a run for the details.</p>\n";
+  for (const std::string& l : left_out)
+    h << "<p class='bad'>Left out, unreadable: " << escape(l) << "</p>\n";
 
   // contents
   h << "<nav class='toc'><b>Contents</b><ol>"

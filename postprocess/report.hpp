@@ -12,7 +12,9 @@
 
 namespace flocsim::postprocess {
 
+// `left_out`: the database rows that cannot be read, one line each.
 void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
-                  const std::string& database, const std::filesystem::path& file);
+                  const std::string& database, const std::filesystem::path& file,
+                  const std::vector<std::string>& left_out = {});
 
 }  // namespace flocsim::postprocess

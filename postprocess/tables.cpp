@@ -41,94 +41,99 @@ std::string baseline_key(const json& case_json) {
 
 }  // namespace
 
-std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::string>& sweep,
-                                  const std::vector<orchestrator::Filter>& where) {
-  std::vector<db::SweepRecord> sweeps;
-  if (sweep) {
-    const auto s = db.find_sweep(*sweep);
-    if (!s) {
-      std::string known;
-      for (const auto& k : db.sweeps()) known += (known.empty() ? "" : ", ") + k.name;
-      throw input::InputError("--sweep " + *sweep + ": no such sweep in " + db.path() + " (" +
-                              (known.empty() ? "none" : known) + ")");
+namespace {
+
+// What the tables need from one readable run (orchestrator::select_runs has
+// checked the types of every field read here).
+RunSummary summary_of(const orchestrator::RunView& v) {
+  const db::ResultsDb::ResultRow& r = v.row;
+  RunSummary u;
+  u.id = r.run.id;
+  u.status = r.run.status;
+  u.run_dir = r.run.run_dir;
+  u.sweep = v.sweep;
+  u.case_json = v.input_case;
+  u.phi = number_at(u.case_json, "phi", 0);
+  u.re_inf = number_at(u.case_json, "Re_inf", 0);
+  u.du = number_at(u.case_json, "du_over_Uinf", 0);
+  u.fidelity = u.case_json.value("fidelity", std::string("standard"));
+  u.has_result = r.has_result;
+  u.wall_s = r.wall_s;
+  u.flocsim_version = r.flocsim_version;
+  u.U_over_Uinf = observable(r, "U_over_Uinf");
+  u.F = observable(r, "F");
+  u.Re = observable(r, "Re");
+  u.Re_T = observable(r, "Re_T");
+  u.C_sph = observable(r, "C_sph");
+  u.n_a = observable(r, "n_a_mean");
+  if (v.result.is_object()) {
+    const json& res = v.result;
+    const json& obs = res.value("observables", json::object());
+    for (const std::string_view summary : result_names::kSummaryObservables) {
+      const std::string name(summary);
+      if (obs.contains(name) && obs[name].is_object() && !obs[name].value("error_reliable", true))
+        u.errors_reliable = false;
     }
-    sweeps.push_back(*s);
-  } else {
-    sweeps = db.sweeps();
+    for (const auto& n : res.value("not_stationary", json::array()))
+      if (n.is_string()) u.not_stationary.push_back(n.get<std::string>());
+    if (obs.contains("window") && obs["window"].is_object()) {
+      u.window_start = obs["window"].value("start", 0.0);
+      u.window_end = obs["window"].value("end", 0.0);
+    }
+    if (res.contains("case") && res["case"].is_object()) {
+      // as the current version writes it (older results lack fields that
+      // had one value then), so that only a real difference counts
+      const json rc = cases::with_older_versions_models(res["case"]);
+      const json lubrication = rc.value("lubrication_model", json());
+      const json numerics = rc.value("numerics", json::object());
+      u.resolved_models =
+          "lubrication_model " +
+          (lubrication.is_string() ? lubrication.get<std::string>() : std::string("none")) +
+          ", immersed boundary " +
+          (numerics.is_object() ? numerics.value("immersed_boundary", json()) : json()).dump();
+    }
+    u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
+    if (u.phi == 0) u.phi = res.value("derived", json::object()).value("phi_realised", 0.0);
+  }
+  return u;
+}
+
+}  // namespace
+
+std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::string>& sweep,
+                                  const std::vector<orchestrator::Filter>& where,
+                                  std::vector<orchestrator::DamagedRun>* left_out) {
+  // the same selection as `flocsim query`
+  const orchestrator::RunSelection chosen = orchestrator::select_runs(db, sweep, where);
+  if (left_out) *left_out = chosen.damaged;
+  // A baseline is the same case: looked up in the whole database, also where
+  // the selection (a sweep, a filter on du) leaves it out.
+  const orchestrator::RunSelection whole =
+      sweep || !where.empty() ? orchestrator::select_runs(db, std::nullopt, {}) : chosen;
+  std::map<std::string, std::vector<std::shared_ptr<const RunSummary>>> zero_du;
+  for (const orchestrator::RunView& v : whole.runs) {
+    auto b = std::make_shared<RunSummary>(summary_of(v));
+    // keyed like the lookup below, so that a case that leaves du_over_Uinf
+    // at its default 0 is found too
+    if (b->du == 0) zero_du[baseline_key(b->case_json)].push_back(b);
+  }
+  for (const orchestrator::DamagedRun& d : whole.damaged) {
+    if (!d.input_case.is_object() || number_at(d.input_case, "du_over_Uinf", 0) != 0) continue;
+    auto b = std::make_shared<RunSummary>();
+    b->id = d.run_id;
+    b->sweep = d.sweep;
+    b->case_json = d.input_case;
+    b->damage = d.field + " " + d.problem;
+    zero_du[baseline_key(b->case_json)].push_back(b);
   }
   std::vector<RunSummary> out;
-  std::set<std::string> seen;
-  for (const db::SweepRecord& s : sweeps)
-    for (const db::ResultsDb::ResultRow& r : db.result_rows(s.id)) {
-      if (!seen.insert(r.run.id).second) continue;  // a run shared by two sweeps: once
-      RunSummary u;
-      u.id = r.run.id;
-      u.status = r.run.status;
-      u.run_dir = r.run.run_dir;
-      u.sweep = s.name;
-      u.case_json = json::parse(r.run.case_json, nullptr, false);
-      if (!u.case_json.is_object()) continue;  // not a case this tool can read
-      u.phi = number_at(u.case_json, "phi", 0);
-      u.re_inf = number_at(u.case_json, "Re_inf", 0);
-      u.du = number_at(u.case_json, "du_over_Uinf", 0);
-      u.fidelity = u.case_json.value("fidelity", std::string("standard"));
-      u.has_result = r.has_result;
-      u.wall_s = r.wall_s;
-      u.flocsim_version = r.flocsim_version;
-      u.U_over_Uinf = observable(r, "U_over_Uinf");
-      u.F = observable(r, "F");
-      u.Re = observable(r, "Re");
-      u.Re_T = observable(r, "Re_T");
-      u.C_sph = observable(r, "C_sph");
-      u.n_a = observable(r, "n_a_mean");
-      if (!r.result_json.empty()) {
-        const json res = json::parse(r.result_json, nullptr, false);
-        if (res.is_object()) {
-          const json& obs = res.value("observables", json::object());
-          for (const std::string_view summary : result_names::kSummaryObservables) {
-            const std::string name(summary);
-            if (obs.contains(name) && obs[name].is_object() &&
-                !obs[name].value("error_reliable", true))
-              u.errors_reliable = false;
-          }
-          for (const auto& n : res.value("not_stationary", json::array()))
-            if (n.is_string()) u.not_stationary.push_back(n.get<std::string>());
-          if (obs.contains("window") && obs["window"].is_object()) {
-            u.window_start = obs["window"].value("start", 0.0);
-            u.window_end = obs["window"].value("end", 0.0);
-          }
-          if (res.contains("case") && res["case"].is_object()) {
-            // as the current version writes it (older results lack fields that
-            // had one value then), so that only a real difference counts
-            const json rc = cases::with_older_versions_models(res["case"]);
-            const json lubrication = rc.value("lubrication_model", json());
-            const json numerics = rc.value("numerics", json::object());
-            u.resolved_models =
-                "lubrication_model " +
-                (lubrication.is_string() ? lubrication.get<std::string>() : std::string("none")) +
-                ", immersed boundary " +
-                (numerics.is_object() ? numerics.value("immersed_boundary", json()) : json())
-                    .dump();
-          }
-          u.sphere_count = res.value("derived", json::object()).value("sphere_count", 0);
-          if (u.phi == 0) u.phi = res.value("derived", json::object()).value("phi_realised", 0.0);
-        }
-      }
-      // the same filters as `flocsim query`: a case path, the status or an observable
-      bool keep = true;
-      for (const orchestrator::Filter& f : where) {
-        json v;
-        if (f.field == "status") {
-          v = to_string(u.status);
-        } else if (const auto c = orchestrator::get_path(u.case_json, f.field)) {
-          v = *c;
-        } else if (const auto o = observable(r, f.field)) {
-          v = o->mean;
-        }
-        keep = keep && orchestrator::filter_matches(v, f);
-      }
-      if (keep) out.push_back(std::move(u));
-    }
+  for (std::size_t i : chosen.selected) {
+    RunSummary u = summary_of(chosen.runs[i]);
+    if (u.du > 0)
+      if (const auto it = zero_du.find(baseline_key(u.case_json)); it != zero_du.end())
+        u.zero_du_runs = it->second;
+    out.push_back(std::move(u));
+  }
   return out;
 }
 
@@ -140,11 +145,6 @@ Measured ratio(const Measured& a, const Measured& b) {
 }
 
 std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs) {
-  std::map<std::string, std::vector<const RunSummary*>> zero_du;  // by case identity
-  for (const RunSummary& r : runs)
-    // keyed like the lookup below, so that a case that leaves du_over_Uinf
-    // at its default 0 is found too
-    if (r.du == 0) zero_du[baseline_key(r.case_json)].push_back(&r);
   std::vector<AggregationRow> rows;
   for (const RunSummary& r : runs) {
     if (r.du <= 0) continue;
@@ -161,17 +161,14 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
              r.resolved_models == b->resolved_models;
     };
     auto usable = [](const RunSummary* b) {
-      return b->status == db::RunState::kCompleted && b->F && b->n_a;
+      return b->damage.empty() && b->status == db::RunState::kCompleted && b->F && b->n_a;
     };
     // the first du = 0 run of the case that can serve (completed, same
     // models); else the first one, to say why it cannot
-    const auto it = zero_du.find(baseline_key(r.case_json));
     const RunSummary* base = nullptr;
-    if (it != zero_du.end()) {
-      for (const RunSummary* b : it->second)
-        if (!base && usable(b) && same_models(b)) base = b;
-      if (!base) base = it->second.front();
-    }
+    for (const auto& b : r.zero_du_runs)
+      if (!base && usable(b.get()) && same_models(b.get())) base = b.get();
+    if (!base && !r.zero_du_runs.empty()) base = r.zero_du_runs.front().get();
     const bool other_models = base && !same_models(base);
     if (r.status != db::RunState::kCompleted || !r.F || !r.n_a) {
       row.reason = "this run is " + to_string(r.status) + (r.has_result ? " (no F or <n_a>)" : "");
@@ -179,6 +176,9 @@ std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& run
       row.reason =
           "no du = 0 run of the same case (same phi, Re_inf, fidelity, numerics, box, seed and "
           "protocol) in the database";
+    } else if (!base->damage.empty()) {
+      row.reason = "its du = 0 run " + base->id.substr(0, 12) +
+                   " cannot be read and is left out (" + base->damage + ")";
     } else if (other_models) {
       row.reason = "its du = 0 run " + base->id.substr(0, 12) + " ran with " +
                    base->resolved_models + ", this one with " + r.resolved_models +

@@ -12,6 +12,7 @@
 // Errors: each mean carries its batch-means standard error; a ratio r = a/b of
 // two independent runs carries e_r = |r| sqrt((e_a/a)^2 + (e_b/b)^2) (first
 // order). docs/postprocess.md.
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
@@ -20,6 +21,7 @@
 
 #include "db/results_db.hpp"
 #include "orchestrator/report.hpp"
+#include "orchestrator/run_selection.hpp"
 #include "postprocess/paper_values.hpp"
 
 namespace flocsim::postprocess {
@@ -49,12 +51,21 @@ struct RunSummary {
   // immersed-boundary scheme), which the input case may leave to defaults
   // that changed between versions; empty without a result.
   std::string resolved_models;
+  // A run with du/U_inf > 0: every du = 0 run of the same case in the whole
+  // database, whatever the selection (load_runs fills it), in grid order.
+  std::vector<std::shared_ptr<const RunSummary>> zero_du_runs;
+  // A du = 0 run whose row cannot be read: what is wrong (it is never a
+  // baseline, only named as the reason there is none).
+  std::string damage;
 };
 
-// The runs of the database (of one sweep when given), filtered like `flocsim
-// query --where`, in grid order.
+// The runs of the database (of one sweep when given), selected as `flocsim
+// query` selects them (orchestrator/run_selection.hpp: the same columns, case
+// fields and refusals), in grid order. Rows that cannot be read are left out
+// and, when `left_out` is given, listed there.
 std::vector<RunSummary> load_runs(db::ResultsDb& db, const std::optional<std::string>& sweep,
-                                  const std::vector<orchestrator::Filter>& where);
+                                  const std::vector<orchestrator::Filter>& where,
+                                  std::vector<orchestrator::DamagedRun>* left_out = nullptr);
 
 // r = a / b with its first-order error for independent a and b.
 Measured ratio(const Measured& a, const Measured& b);
@@ -70,7 +81,8 @@ struct AggregationRow {
   // own du, a bound at any other (paper_values.hpp)
   std::optional<PaperNormalisedSize> n_over_n0_paper;
 };
-// One row per run with du/U_inf > 0, paired where a completed baseline exists.
+// One row per run with du/U_inf > 0, paired where a completed baseline exists
+// (among its zero_du_runs: the whole database, not only the selection).
 std::vector<AggregationRow> aggregation_table(const std::vector<RunSummary>& runs);
 
 struct NonAggregatingRow {

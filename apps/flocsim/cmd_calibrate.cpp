@@ -17,10 +17,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 
 #include "apps/flocsim/command_registry.hpp"
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/calibration/pair_resistance.hpp"
+#include "engine/calibration/table_file.hpp"
+#include "engine/input/input_reader.hpp"
 
 namespace flocsim::app {
 namespace {
@@ -67,9 +70,7 @@ void print_pair_point(const calibration::PairResistancePoint& p) {
 }
 
 int run_pair_calibration(const CalibrateOptions& o) {
-  calibration::PairResistanceTable table;
-  if (std::filesystem::exists(o.table)) table = calibration::PairResistanceTable::load(o.table);
-  table.note =
+  const std::string note =
       "The lattice's own radial resistance lambda of two immersed-boundary spheres held at gap s "
       "and moved towards each other at +-V (Re = 2aV/nu = 0.01), box L x L/2 x L/2 (L, the "
       "box field of each entry, is 16a or 12a), double precision, steady to 2e-6 per 200 steps, "
@@ -89,11 +90,26 @@ int run_pair_calibration(const CalibrateOptions& o) {
         calibration::calibrate_pair_resistance(a, gaps, o.separating, s, print_pair_point);
     std::printf("=> box offset %+.4f (at s/a = %g); lambda_IB = measured - offset\n", e.box_offset,
                 gaps.back());
-    table.add(e);
-    table.save(o.table);
+    // under the table's lock, with what other calibrations added meanwhile
+    calibration::add_to_table_file(o.table, e, note);
   }
   std::printf("table written to %s\n", o.table.c_str());
   return kExitOk;
+}
+
+std::string number_text(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+// The cube edges of the radius calibration at a: --boxes, else chi = 2a/L of
+// 0.35, 0.5 and 0.7.
+std::vector<int> boxes_of(const CalibrateOptions& o, double a) {
+  std::vector<int> boxes = o.boxes;
+  if (boxes.empty())
+    for (double chi : o.chis) boxes.push_back(static_cast<int>(std::lround(2.0 * a / chi)));
+  return boxes;
 }
 
 void print_run(const calibration::ArrayDragResult& r) {
@@ -106,11 +122,8 @@ void print_run(const calibration::ArrayDragResult& r) {
   std::fflush(stdout);
 }
 
-int run_calibrate(const CalibrateOptions& o) {
-  if (o.close_pairs) return run_pair_calibration(o);
-  calibration::CalibrationTable table;
-  if (std::filesystem::exists(o.table)) table = calibration::CalibrationTable::load(o.table);
-  table.note =
+int run_radius_calibration(const CalibrateOptions& o) {
+  const std::string note =
       "Hydrodynamic radius a of immersed-boundary spheres (multi-direct forcing; each entry names "
       "its marker spacing, sweeps ('iterations') and kernel) against input radius a_g. Made by "
       "`flocsim calibrate`: one fixed sphere in periodic cubes "
@@ -125,9 +138,7 @@ int run_calibrate(const CalibrateOptions& o) {
   s.tolerance = o.tolerance;
   s.grid_offsets = o.grid_offsets;
   for (double a : o.radii) {
-    std::vector<int> boxes = o.boxes;
-    if (boxes.empty())
-      for (double chi : o.chis) boxes.push_back(static_cast<int>(std::lround(2.0 * a / chi)));
+    const std::vector<int> boxes = boxes_of(o, a);
     std::printf("hydrodynamic radius a = %g dx, nu = %g, %s:\n", a, o.viscosity,
                 s.scheme.describe().c_str());
     const auto entry = calibration::calibrate_input_radius(a, boxes, s, print_run);
@@ -136,11 +147,66 @@ int run_calibrate(const CalibrateOptions& o) {
       spread = std::max(spread, std::abs(radius - a));
     std::printf("=> a_g = %.4f for a = %g (largest box deviation %.4f dx)\n", entry.input_radius, a,
                 spread);
-    table.add(entry);
-    table.save(o.table);  // after every radius, so a long calibration keeps what it has
+    // after every radius, so a long calibration keeps what it has; under the
+    // table's lock, with what other calibrations added meanwhile
+    calibration::add_to_table_file(o.table, entry, note);
   }
   std::printf("table written to %s\n", o.table.c_str());
   return kExitOk;
+}
+
+// Refuses, before any work, what the chosen calibration would not use or
+// could not write: an option of the other calibration, a table that is not
+// one of this kind or cannot be written (engine/calibration/table_file.hpp).
+void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
+  const std::vector<const char*> pair_only = {"--separating", "--gaps", "--pair-box",
+                                              "--input-radius"};
+  const std::vector<const char*> radius_only = {"--boxes", "--tolerance", "--grid-offsets"};
+  for (const char* name : o.close_pairs ? radius_only : pair_only)
+    if (cmd.get_option(name)->count() > 0)
+      throw input::InputError(
+          std::string(name) +
+          (o.close_pairs ? ": only for the hydrodynamic-radius calibration (without "
+                           "--close-pairs); the close-pair calibration does not use it"
+                         : ": only with --close-pairs; the hydrodynamic-radius calibration "
+                           "does not use it"));
+  for (std::size_t k = 1; k < o.gaps.size(); ++k)
+    if (!(o.gaps[k] > o.gaps[k - 1]))
+      throw input::InputError("--gaps: must increase (the last gives the box offset), got " +
+                              number_text(o.gaps[k - 1]) + " then " + number_text(o.gaps[k]));
+  // a sphere must not reach its own periodic image: the immersed boundary
+  // needs L > 2 a_g + 3 (its kernel), partially saturated cells
+  // L > 2 (a_g + sqrt(3)/2); checked here for the first pass's a_g = a - 0.3
+  // (the couplings refuse it themselves, but only once a run starts)
+  if (!o.close_pairs)
+    for (double a : o.radii) {
+      const double ag = a - 0.3;
+      const bool markers = o.method == coupling::method_name(coupling::Method::immersed_boundary);
+      const double reach = markers ? 2 * ag + 3 : 2 * (ag + 0.8660254037844386);
+      for (int box : boxes_of(o, a))
+        if (box <= reach)
+          throw input::InputError(
+              (o.boxes.empty() ? "the default box " + std::to_string(box) + " (chi = 2a/L of " +
+                                     "0.35, 0.5, 0.7)"
+                               : "--boxes " + std::to_string(box)) +
+              " for --radius " + number_text(a) + ": a cube must exceed " +
+              (markers ? "2 a_g + 3 = " : "2 (a_g + sqrt(3)/2) = ") + number_text(reach) +
+              " dx with the first input radius tried, a_g = a - 0.3 (a sphere must not reach its "
+              "own periodic image); give --boxes with larger edges");
+    }
+  calibration::check_table_file(o.table, o.close_pairs
+                                             ? calibration::TableKind::close_pair
+                                             : calibration::TableKind::hydrodynamic_radius);
+}
+
+int run_calibrate(const CalibrateOptions& o, const CLI::App& cmd) {
+  try {
+    check_before_work(o, cmd);
+  } catch (const input::InputError& e) {
+    std::cerr << "flocsim calibrate: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return o.close_pairs ? run_pair_calibration(o) : run_radius_calibration(o);
 }
 
 const bool registered = register_command(
@@ -150,14 +216,14 @@ const bool registered = register_command(
        auto o = std::make_shared<CalibrateOptions>();
        cmd.add_option("--radius", o->radii, "wanted hydrodynamic radii a (dx)")
            ->required()
-           ->check(CLI::Range(2.0, 40.0));
+           ->check(finite_number(2.0, 40.0));
        cmd.add_option("--viscosity", o->viscosity, "lattice viscosity of the calibration runs")
-           ->check(CLI::Range(0.005, 0.5));
+           ->check(finite_number(0.005, 0.5));
        cmd.add_option("--boxes", o->boxes,
                       "cube edges L (dx); default: chi = 2a/L of 0.35, 0.5, 0.7")
            ->check(CLI::Range(8, 400));
        cmd.add_option("--marker-spacing", o->marker_spacing, "marker spacing (dx)")
-           ->check(CLI::Range(0.3, 1.5));
+           ->check(finite_number(0.3, 1.5));
        cmd.add_option("--sweeps,--iterations", o->sweeps, "direct-forcing sweeps per step")
            ->check(CLI::Range(1, 20));
        cmd.add_option("--kernel", o->kernel, "interpolation/spreading kernel")
@@ -169,15 +235,16 @@ const bool registered = register_command(
            ->check(CLI::IsMember(coupling::forcing_names()));
        cmd.add_option("--gains", o->gains,
                       "control forcing: integral and proportional gain (docs/coupling.md)")
-           ->expected(2);
+           ->expected(2)
+           ->check(finite_number(0.0, 1e6));
        cmd.add_option("--grid-offsets", o->grid_offsets,
                       "run each box with the sphere's centre at floor(L/2) + d for each d (0: on a "
                       "node, 0.5: mid-cell) and average: for schemes whose boundary depends on "
                       "where it sits on the grid (default: centred at L/2, one run)")
-           ->check(CLI::Range(0.0, 1.0));
+           ->check(finite_number(0.0, 1.0));
        cmd.add_option("--tolerance", o->tolerance,
                       "steady state: relative change of U per 100 steps")
-           ->check(CLI::Range(1e-10, 1e-3));
+           ->check(finite_number(1e-10, 1e-3));
        cmd.add_flag("--close-pairs", o->close_pairs,
                     "measure the lattice's own close-pair resistance instead (lubrication "
                     "calibration)");
@@ -185,18 +252,18 @@ const bool registered = register_command(
        cmd.add_option("--gaps", o->gaps,
                       "with --close-pairs: gaps s/a, increasing; the last "
                       "gives the box offset (default 0.005 ... 0.5)")
-           ->check(CLI::Range(1e-4, 2.0));
+           ->check(finite_number(1e-4, 2.0));
        cmd.add_option("--pair-box", o->pair_box_over_a,
                       "with --close-pairs: box length along the pair in units of a (cross-section "
                       "half of it)")
-           ->check(CLI::Range(8.0, 64.0));
+           ->check(finite_number(8.0, 64.0));
        cmd.add_option("--input-radius", o->input_radius,
                       "with --close-pairs: the spheres' input radius a_g (default: the shipped "
                       "calibration's for the scheme at --radius and --viscosity)")
-           ->check(CLI::Range(1.0, 40.0));
+           ->check(finite_number(1.0, 40.0));
        cmd.add_option("--table", o->table, "calibration table (JSON), read and extended")
            ->required();
-       return [o] { return run_calibrate(*o); };
+       return [o, &cmd] { return run_calibrate(*o, cmd); };
      }});
 
 }  // namespace

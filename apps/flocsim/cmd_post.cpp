@@ -34,8 +34,9 @@ void write_file(const fs::path& p, const std::string& text) {
 
 // Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table:
 // the columns a user reads first, fitted to the terminal (the files keep all).
-void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out,
-                  const PostOptions& o) {
+// The rows left out as unreadable are listed beside them in left_out.md.
+void write_tables(const std::vector<pp::RunSummary>& runs, const std::vector<std::string>& left_out,
+                  const fs::path& out, const PostOptions& o) {
   const auto agg = pp::aggregation_table(runs);
   const auto non = pp::non_aggregating_table(runs);
   for (const std::string format : {"csv", "md", "tex"}) {
@@ -46,6 +47,14 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out,
     write_file(out / ("non_aggregating." + format), n.str());
   }
   write_file(out / "columns.md", pp::column_definitions());
+  // written every time, so that an earlier post's list never outlives its truth
+  std::string text = "# Rows left out\n\n";
+  if (left_out.empty())
+    text += "None: every selected row of the database could be read.\n";
+  else
+    text += "These rows of the database cannot be read and are in no table:\n\n";
+  for (const std::string& l : left_out) text += "- " + l + "\n";
+  write_file(out / "left_out.md", text);
   std::cout << "Aggregation: F/F0 against <n_a>/<n_a>0 (" << agg.size()
             << " runs with du > 0; every column in " << (out / "aggregation.md").string()
             << ")\n\n";
@@ -57,27 +66,46 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const fs::path& out,
             << (out / "non_aggregating.md").string()
             << "\nTables (CSV, Markdown, LaTeX) and their column definitions (columns.md) in "
             << out.string() << "\n";
+  if (!left_out.empty())
+    std::cout << left_out.size() << " unreadable row" << (left_out.size() > 1 ? "s" : "")
+              << " left out of the tables: " << (out / "left_out.md").string() << "\n";
 }
 
 int post(const std::string& what, const PostOptions& o) {
   try {
     std::vector<orchestrator::Filter> where;
     for (const std::string& w : o.where) where.push_back(orchestrator::parse_filter(w));
+    // said before any work: without gnuplot there are no figures
+    const std::string no_figures = what == "tables" ? "" : pp::why_no_figures();
+    if (!no_figures.empty()) {
+      if (what == "figures") {
+        std::cerr << "flocsim post figures: no figures can be drawn: " << no_figures << "\n";
+        return kExitFailure;
+      }
+      std::cerr << "flocsim post report: no figures: " << no_figures
+                << "; the tables and a report without figures are written\n";
+    }
     db::ResultsDb db(o.db_path, db::ResultsDb::Mode::kReadOnly);
+    std::vector<orchestrator::DamagedRun> damaged;
     const auto runs = pp::load_runs(
-        db, o.sweep.empty() ? std::nullopt : std::optional<std::string>(o.sweep), where);
+        db, o.sweep.empty() ? std::nullopt : std::optional<std::string>(o.sweep), where, &damaged);
+    std::vector<std::string> left_out;
+    for (const auto& d : damaged) {
+      left_out.push_back(d.text());
+      std::cerr << "flocsim post: left out, unreadable: " << d.text() << "\n";
+    }
     const fs::path out(o.out_dir);
     fs::create_directories(out);
     if (what == "tables") {
-      write_tables(runs, out, o);
+      write_tables(runs, left_out, out, o);
     } else {
       const pp::FigureSet figures = pp::write_figures(runs, out / "figures");
       if (what == "figures")
         for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
       for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
       if (what == "report") {
-        write_tables(runs, out, o);
-        pp::write_report(runs, figures, o.db_path, out / "report.html");
+        write_tables(runs, left_out, out, o);
+        pp::write_report(runs, figures, o.db_path, out / "report.html", left_out);
       }
       std::cout << figures.figures.size() << " figures (PNG and PDF, with their data and gnuplot "
                 << "scripts) in " << (out / "figures").string() << "\n";

@@ -45,6 +45,7 @@ const bool registered = register_command(
            q.columns = o->columns;
            // a chosen set of columns, or --all, is shown whole
            q.width = o->all || !o->columns.empty() ? 0 : orc::terminal_width();
+           q.left_out = &std::cerr;
            for (const std::string& w : o->where) q.where.push_back(orc::parse_filter(w));
            db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kReadOnly);  // only reads
            orc::write_query(db, q, std::cout);

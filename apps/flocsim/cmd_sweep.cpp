@@ -156,10 +156,10 @@ void common_run_options(CLI::App& cmd, SweepOptions& o) {
       ->check(CLI::IsMember({"local", "slurm"}));
   cmd.add_option("--lease", o.lease_s,
                  "Seconds without a heartbeat (progress.json) after which a worker is lost")
-      ->check(CLI::Range(5.0, 1e6));
+      ->check(finite_number(5.0, 1e6));
   cmd.add_option("--grace", o.grace_s,
                  "Seconds a stopping worker may take to write its checkpoint before it is killed")
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(finite_number(1.0, 1e6));
   cmd.add_option("--worker", o.worker,
                  "Program run as `WORKER run CASE --out DIR` (default: this flocsim, or "
                  "$FLOCSIM_WORKER)");
@@ -210,11 +210,12 @@ const bool registered = register_command(
        CLI::App* status = cmd.add_subcommand("status", "Runs by state, progress, ETA, failures");
        status->add_option("--db", o->db_path, "Results database")->required();
        status->add_option("--sweep", o->sweep_name, "Only this sweep");
-       status->add_option("--lease", o->lease_s, "Heartbeat lease for remote workers (s)");
+       status->add_option("--lease", o->lease_s, "Heartbeat lease for remote workers (s)")
+           ->check(finite_number(5.0, 1e6));
        status
            ->add_option("--watch", o->watch_s,
                         "Refresh every SECONDS, in place, until nothing runs")
-           ->check(CLI::Range(0.5, 86400.0));
+           ->check(finite_number(0.5, 86400.0));
        status->callback([action] { *action = "status"; });
 
        CLI::App* cancel = cmd.add_subcommand(
@@ -228,7 +229,7 @@ const bool registered = register_command(
        task->add_option("--sweep", o->sweep_name)->required();
        task->add_option("--task-file", o->task_file)->required();
        task->add_option("--worker", o->worker)->required();
-       task->add_option("--lease", o->lease_s);
+       task->add_option("--lease", o->lease_s)->check(finite_number(5.0, 1e6));
        task->callback([action] { *action = "slurm-task"; });
 
        return CommandHandler([o, action]() -> int {

@@ -8,6 +8,8 @@
 // `setup` declares the subcommand's options on `cmd` and returns the function
 // that runs it once parsing succeeded; that function returns the exit code.
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -26,6 +28,23 @@ struct Command {
 
 bool register_command(Command command);
 const std::vector<Command>& commands();
+
+// The check of every number option: a finite number in [low, high]. CLI11's
+// Range lets "nan" through (each comparison with NaN is false: a NaN
+// tolerance never converged); CLI11 names the option in front of the message.
+inline CLI::Validator finite_number(double low, double high) {
+  char range[96];
+  std::snprintf(range, sizeof range, "a finite number in [%g, %g]", low, high);
+  const std::string allowed = range;
+  return CLI::Validator(
+      [low, high, allowed](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v)) return "must be " + allowed + ", got " + text;
+        if (!std::isfinite(v) || v < low || v > high) return "must be " + allowed + ", got " + text;
+        return {};
+      },
+      "in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
+}
 
 // Exit codes shared by all subcommands and the orchestrator's workers
 // (docs/user-guide.md): defined once, in engine/process/exit_codes.hpp.

@@ -105,27 +105,67 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
   return scheme;
 }
 
-// "{marker_spacing 1, sweeps 1, kernel roma3}"
-std::string scheme_fields(const coupling::Scheme& s) {
+// "{marker_spacing 1, sweeps 1, kernel roma3}"; with the case's
+// numerics.immersed_boundary as written (`given`), a field it leaves out is
+// marked "(default)": the user sees which values they did not choose.
+std::string scheme_fields(const coupling::Scheme& s,
+                          const nlohmann::json& given = nlohmann::json()) {
+  auto field = [&](const char* name, const std::string& value) {
+    const bool defaulted = given.is_object() && !given.contains(name);
+    return std::string(name) + " " + value + (defaulted ? " (default)" : "");
+  };
   if (!s.immersed_boundary()) return "{coupling partially-saturated}";
   if (s.control())
-    return "{forcing control, marker_spacing " + format_value(s.marker_spacing) + ", kernel " +
-           coupling::kernel_name(s.kernel) + "}";
-  return "{marker_spacing " + format_value(s.marker_spacing) + ", sweeps " +
-         std::to_string(s.sweeps) + ", kernel " + coupling::kernel_name(s.kernel) + "}";
+    return "{forcing control, " + field("marker_spacing", format_value(s.marker_spacing)) + ", " +
+           field("kernel", coupling::kernel_name(s.kernel)) + "}";
+  return "{" + field("marker_spacing", format_value(s.marker_spacing)) + ", " +
+         field("sweeps", std::to_string(s.sweeps)) + ", " +
+         field("kernel", coupling::kernel_name(s.kernel)) + "}";
+}
+
+// The case field that names a scheme.
+std::string coupling_field(const coupling::Scheme& s) {
+  return s.immersed_boundary() ? "numerics.immersed_boundary" : "numerics.coupling";
+}
+
+// The refusal of a scheme used beyond the solids fraction it is validated for.
+InputError beyond_validated_phi(const coupling::Scheme& scheme, const nlohmann::json& given,
+                                double phi) {
+  const std::string limit = format_value(coupling::largest_validated_phi(scheme));
+  if (scheme.immersed_boundary() && !scheme.control())
+    return InputError("numerics.immersed_boundary = " + scheme_fields(scheme, given) +
+                      " with phi = " + format_value(phi) + ": " + std::to_string(scheme.sweeps) +
+                      " forcing sweep" + (scheme.sweeps == 1 ? " is" : "s are") +
+                      " validated only up to phi = " + limit +
+                      " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
+                      "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
+                      "(docs/accuracy-cost.md)");
+  return InputError(coupling_field(scheme) + " = " + scheme_fields(scheme, given) +
+                    " with phi = " + format_value(phi) + ": " + scheme.describe() +
+                    " is checked only up to phi = " + limit +
+                    " (docs/coupling.md); use the paper's direct forcing (the default of "
+                    "fidelity \"paper\") above it");
+}
+
+std::string box_text(const std::vector<double>& b) {
+  return format_value(b[0]) + " x " + format_value(b[1]) + " x " + format_value(b[2]);
 }
 
 // Sphere centres of a snapshot written by a run (spheres/step_N.h5), checked
-// against this case: same radius, inside the box, no overlap.
+// against this case: the same box (the snapshot's record of it, or for older
+// snapshots that lack one, `given_box`, the case's positions_from_box), same
+// radius, inside the box, no overlap.
 std::vector<double> snapshot_positions(const std::string& file, double a,
-                                       const lattice::Extent& box) {
+                                       const lattice::Extent& box,
+                                       const std::vector<double>& given_box) {
   const std::string field = "positions_from = \"" + file + "\"";
-  std::vector<double> x;
+  std::vector<double> x, recorded_box;
   double radius = 0;
   try {
     output::Hdf5File f(file, output::Hdf5File::Mode::read);
     x = f.read<double>("/position");
     radius = f.attribute_double("/", "radius");
+    if (f.exists("/box")) recorded_box = f.read<double>("/box");
   } catch (const std::exception& e) {
     throw InputError(field +
                      ": must be a sphere snapshot (spheres/step_N.h5 of a run): " + e.what());
@@ -136,6 +176,34 @@ std::vector<double> snapshot_positions(const std::string& file, double a,
   if (std::abs(radius - a) > 1e-9)
     throw InputError(field + ": its spheres have radius " + format_value(radius) +
                      ", the case has numerics.a_over_dx = " + format_value(a));
+  const std::vector<double> case_box = {static_cast<double>(box.nx), static_cast<double>(box.ny),
+                                        static_cast<double>(box.nz)};
+  const std::string this_box = "this case's box is " + box_text(case_box) +
+                               " cells (L_over_a, L_over_W and numerics.a_over_dx)";
+  if (!recorded_box.empty()) {
+    if (recorded_box.size() != 3)
+      throw InputError(field + ": /box must hold 3 numbers, holds " +
+                       std::to_string(recorded_box.size()));
+    if (!given_box.empty() && given_box != recorded_box)
+      throw InputError("positions_from_box = [" + box_text(given_box) + "]: " + file +
+                       " records its box as " + box_text(recorded_box) +
+                       " cells; leave positions_from_box out");
+    if (recorded_box != case_box)
+      throw InputError(field + ": its spheres fill a " + box_text(recorded_box) + " box, " +
+                       this_box + "; give the snapshot's L_over_a and L_over_W");
+  } else if (given_box.empty()) {
+    throw InputError(field +
+                     ": records no box (written by a flocsim before snapshots did), so its "
+                     "spheres cannot be checked against this case's box; give the box of the run "
+                     "that wrote it, in cells, as \"positions_from_box\": [nx, ny, nz] (its "
+                     "result.json's derived.box_cells); " +
+                     this_box);
+  } else if (given_box != case_box) {
+    throw InputError("positions_from_box = [" + box_text(given_box) + "]: the snapshot's box is " +
+                     "not this case's; " + this_box +
+                     "; give the snapshot's L_over_a and "
+                     "L_over_W");
+  }
   const double L[3] = {static_cast<double>(box.nx), static_cast<double>(box.ny),
                        static_cast<double>(box.nz)};
   const std::size_t n = x.size() / 3;
@@ -175,7 +243,8 @@ namespace {
 // moving spheres, more than one forcing sweep, a < 6 dx, nu below its floor.
 bool multi_sweep_oscillates(const SuspensionCase& c) {
   return modules_of(c.scene).liquid && modules_of(c.scene).spheres_move &&
-         c.numerics.coupling.sweeps > 1 && c.numerics.radius_cells < 6 &&
+         c.numerics.coupling.immersed_boundary() && c.numerics.coupling.sweeps > 1 &&
+         c.numerics.radius_cells < 6 &&
          c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
 }
 // The U_inf that puts this case's viscosity on that floor.
@@ -207,6 +276,15 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     if (c.positions_from.empty())
       throw InputError(
           "positions_from = \"\": must name a sphere snapshot file (spheres/step_N.h5 of a run)");
+    if (root.has("positions_from_box")) {
+      c.positions_from_box = root.numbers("positions_from_box", 3, {.at_least = 1, .at_most = 1e5});
+      for (double n : c.positions_from_box)
+        if (n != std::round(n))
+          throw InputError("positions_from_box = [" + box_text(c.positions_from_box) +
+                           "]: must be whole numbers of cells");
+    }
+  } else if (root.has("positions_from_box")) {
+    throw InputError("positions_from_box: only with positions_from (the box of its snapshot)");
   }
   if (!single && c.positions_from.empty())
     c.physics.phi = root.number(
@@ -222,6 +300,13 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "calibrated");
   c.physics.lubrication_integration =
       root.choice("lubrication_integration", {"implicit", "explicit-paper"}, "implicit");
+  // A scene without lubrication runs no model: one named there (a suspension's
+  // case reused for its fixed array) is not recorded as if it had run.
+  if (!modules_of(c.scene).lubrication)
+    for (const char* key : {"lubrication_model", "lubrication_integration"})
+      if (root.has(key))
+        c.warnings.push_back(std::string(key) + ": scene \"" + std::string(scene_name(c.scene)) +
+                             "\" has no lubrication, so no model runs; not recorded");
   c.physics.lubrication_onset_over_a =
       root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
   c.physics.lubrication_saturation_over_a =
@@ -311,6 +396,20 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       }
     }
   }
+  // numerics.immersed_boundary as the case file writes it, for messages that
+  // show the scheme: a field it leaves out is marked as the default
+  const nlohmann::json ib_given =
+      document.contains("numerics") && document["numerics"].contains("immersed_boundary")
+          ? document["numerics"]["immersed_boundary"]
+          : nlohmann::json::object();
+  // A scheme asked for beyond the phi it is validated for is refused for that
+  // (below) before its calibration is looked for: one sweep at phi 0.3 is not
+  // to be calibrated but replaced.
+  auto refuse_beyond_validated_phi = [&] {
+    if (c.positions_from.empty() &&
+        c.physics.phi > coupling::largest_validated_phi(c.numerics.coupling))
+      throw beyond_validated_phi(c.numerics.coupling, ib_given, c.physics.phi);
+  };
   c.numerics.input_radius_given = num.has("input_radius");
   if (c.numerics.input_radius_given) {
     // where each scheme puts its boundary relative to its input radius (the
@@ -393,8 +492,10 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       const std::string n = scheme_fields(e.scheme);
       if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
     }
+    if (!offered) refuse_beyond_validated_phi();
     if (!offered)
-      throw InputError("numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
+      throw InputError(coupling_field(c.numerics.coupling) + " = " +
+                       scheme_fields(c.numerics.coupling, ib_given) +
                        ": not an offered option (no calibration of it is shipped at any a); "
                        "offered: " +
                        names + " (docs/accuracy-cost.md)");
@@ -411,8 +512,11 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
           "docs/coupling.md); give numerics.input_radius from its calibration there "
           "(a_g = 2.9287 for a_over_dx = 4 at viscosity 0.02)");
     if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
+      refuse_beyond_validated_phi();
+    if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
       throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
+          coupling_field(c.numerics.coupling) + " = " +
+          scheme_fields(c.numerics.coupling, ib_given) +
           ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
           c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
           format_value(a) + " --viscosity NU" +
@@ -530,7 +634,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.derived.sphere_count =
       single ? 1 : static_cast<int>(std::lround(c.physics.phi * volume / sphere_volume));
   if (!c.positions_from.empty()) {
-    c.initial_positions = snapshot_positions(c.positions_from, a, c.derived.box);
+    c.initial_positions =
+        snapshot_positions(c.positions_from, a, c.derived.box, c.positions_from_box);
     c.derived.sphere_count = static_cast<int>(c.initial_positions.size() / 3);
     c.physics.phi = c.derived.sphere_count * sphere_volume / volume;
   }
@@ -543,14 +648,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   const double phi_asked = (c.derived.sphere_count - 0.5) * sphere_volume / volume;
   if (modules_of(c.scene).liquid &&
       phi_asked > coupling::largest_validated_phi(c.numerics.coupling))
-    throw InputError(
-        "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) + " with phi = " +
-        format_value(c.positions_from.empty() ? c.physics.phi : c.derived.phi_realised) +
-        ": this option is validated only up to phi = " +
-        format_value(coupling::largest_validated_phi(c.numerics.coupling)) +
-        " (one forcing sweep leaves the overlap of neighbouring spheres' kernels "
-        "uncorrected: 3-4 % too little drag at phi = 0.27); use sweeps = 2 "
-        "(docs/accuracy-cost.md)");
+    throw beyond_validated_phi(c.numerics.coupling, ib_given,
+                               c.positions_from.empty() ? c.physics.phi : c.derived.phi_realised);
   if (single) c.physics.phi = c.derived.phi_realised;
 
   c.derived.drag_coefficient = schiller_naumann_drag_coefficient(c.physics.reynolds_inf);
@@ -594,8 +693,10 @@ nlohmann::json SuspensionCase::to_json() const {
   j["delta_over_a"] = physics.delta_over_a;
   j["restitution"] = physics.restitution;
   j["friction"] = physics.friction;
-  j["lubrication_model"] = physics.lubrication_model;
-  j["lubrication_integration"] = physics.lubrication_integration;
+  if (modules_of(scene).lubrication) {  // no model runs elsewhere, so none is recorded
+    j["lubrication_model"] = physics.lubrication_model;
+    j["lubrication_integration"] = physics.lubrication_integration;
+  }
   j["lubrication_onset_over_a"] = physics.lubrication_onset_over_a;
   j["lubrication_saturation_over_a"] = physics.lubrication_saturation_over_a;
   j["L_over_a"] = physics.length_over_a;

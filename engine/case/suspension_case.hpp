@@ -137,6 +137,9 @@ struct SuspensionCase {
   // fixed-array only: hold the spheres of this run's snapshot
   // (spheres/step_N.h5) still instead of placing them at random (paper Fig. 1b)
   std::string positions_from;
+  // positions_from_box: the snapshot's box in cells, for snapshots written
+  // before they recorded it (empty when not given); must be this case's box
+  std::vector<double> positions_from_box;
   std::vector<double> initial_positions;  // its centres, x y z per sphere
 
   Physics physics;

@@ -186,10 +186,10 @@ inline constexpr Scheme kPartiallySaturatedScheme{.method = Method::partially_sa
 // single direct-forcing sweep the slip left where neighbouring spheres'
 // kernels overlap is not corrected: simple cubic arrays at phi = 0.27 come out
 // 3.2-3.8 % below Sangani-Acrivos (2 % is the bar), against within 2 % up to
-// phi = 0.2. Control forcing removes that slip by its integral action, and
-// partially saturated cells have no kernels to overlap.
+// phi = 0.2. Control forcing and partially saturated cells have not been
+// checked above phi = 0.2 (docs/coupling.md).
 inline double largest_validated_phi(const Scheme& s) {
-  return s.immersed_boundary() && s.forcing == Forcing::direct && s.sweeps < 2 ? 0.2 : 1.0;
+  return s.immersed_boundary() && s.forcing == Forcing::direct && s.sweeps >= 2 ? 1.0 : 0.2;
 }
 
 }  // namespace flocsim::coupling

@@ -20,7 +20,8 @@ std::vector<double> flatten(const std::vector<spheres::Vec3>& v) {
 }  // namespace
 
 void write_sphere_snapshot(const fs::path& directory, long step, double time,
-                           const spheres::SphereSet& s, const std::vector<int>& aggregate_of) {
+                           const spheres::SphereSet& s, const spheres::PeriodicBox& box,
+                           const std::vector<int>& aggregate_of) {
   fs::create_directories(directory);
   const hsize_t n = s.size();
   {
@@ -35,6 +36,8 @@ void write_sphere_snapshot(const fs::path& directory, long step, double time,
     f.set_attribute("/", "step", static_cast<std::int64_t>(step));
     f.set_attribute("/", "time", time);
     f.set_attribute("/", "radius", s.radius);
+    const double box_cells[3] = {box.length.x(), box.length.y(), box.length.z()};
+    f.write("/box", {3}, box_cells);
     f.close();
     tmp.commit();
   }

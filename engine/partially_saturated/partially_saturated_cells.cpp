@@ -292,10 +292,10 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
   const int length[3] = {e.nx, e.ny, e.nz};
   const double reach = input_radius_ + kHalfDiagonal;
   for (int d = 0; d < 3; ++d)
-    if (length[d] <= 2 * reach + 1)
+    if (length[d] <= 2 * reach)  // else one cell could be within reach of a sphere and its image
       throw std::invalid_argument(
           "partially saturated cells: box length " + std::to_string(length[d]) +
-          " must exceed 2 (a_g + sqrt(3)/2) + 1 = " + std::to_string(2 * reach + 1) +
+          " must exceed 2 (a_g + sqrt(3)/2) = " + std::to_string(2 * reach) +
           " (a sphere must not cover its own periodic image)");
   locate(spheres, e);
   list_runs(spheres, e);

@@ -70,7 +70,24 @@ void refuse_foreign_outputs(const fs::path& dir) {
 
 namespace {
 StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_json);
+std::string difference_text(const nlohmann::json& recorded_case, const nlohmann::json& current_case,
+                            const std::string& recorded_in, bool steps_may_grow);
+
+// The case a completed run's result.json records (the run record's where it
+// has none); null when neither says.
+nlohmann::json completed_case(const fs::path& dir) {
+  for (const char* file : {"result.json", kRunRecord}) {
+    try {
+      std::ifstream in(dir / file);
+      const auto j = nlohmann::json::parse(in);
+      if (j.contains("case") && j["case"].is_object()) return j["case"];
+    } catch (const std::exception&) {
+      // not readable: the next file may say
+    }
+  }
+  return nullptr;
 }
+}  // namespace
 
 StartMode prepare_output_directory(const fs::path& dir, bool resume,
                                    const nlohmann::json& case_json) {
@@ -96,7 +113,22 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
   const bool completed = fs::exists(dir / "result.json");
   const bool checkpoint = fs::exists(dir / "checkpoint.h5");
   if (completed) {
-    if (resume) return StartMode::already_completed;
+    if (resume) {
+      // "already completed" only for the case it completed: another case's
+      // result is not this one's
+      const nlohmann::json recorded = completed_case(dir);
+      if (recorded.is_null())
+        throw input::InputError((dir / "result.json").string() +
+                                ": records no case, so it cannot be the result of this one; use "
+                                "another --out directory");
+      if (!completed_under(recorded, case_json))
+        throw input::InputError(
+            (dir / "result.json").string() + " is the result of a different case (" +
+            difference_text(recorded, case_json, "the result", false) +
+            "); nothing was run. Use another --out directory for this case, or give those "
+            "fields their recorded values");
+      return StartMode::already_completed;
+    }
     throw input::InputError(
         (dir / "result.json").string() +
         " exists: the run in this directory has completed; use another --out directory");
@@ -174,14 +206,16 @@ std::string utc_timestamp() {
 
 namespace {
 // The case with run control removed and the defaults of older checkpoints
-// filled in, as resumable_under compares it.
-nlohmann::json physics_only(nlohmann::json c) {
+// filled in, as resumable_under compares it. `steps_may_grow`: a fluid run's
+// checkpoint may be continued to more steps.
+nlohmann::json physics_only(nlohmann::json c, bool steps_may_grow = true) {
   for (const char* group : {"run", "protocol"}) {
     if (!c.contains(group)) continue;
     for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
       c[group].erase(key);
   }
-  if (c.value("scene", "") == cases::scene_name(cases::Scene::fluid) && c.contains("run"))
+  if (steps_may_grow && c.value("scene", "") == cases::scene_name(cases::Scene::fluid) &&
+      c.contains("run"))
     c["run"].erase("steps");
   // checkpoints from before numerics.immersed_boundary or lubrication_model
   // existed: the one value each had then
@@ -189,17 +223,18 @@ nlohmann::json physics_only(nlohmann::json c) {
 }
 
 void list_differences(const nlohmann::json& was, const nlohmann::json& now,
-                      const std::string& prefix, std::vector<std::string>& out) {
+                      const std::string& prefix, const std::string& recorded_in,
+                      std::vector<std::string>& out) {
   std::set<std::string> keys;
   for (const auto& [k, v] : was.items()) keys.insert(k);
   for (const auto& [k, v] : now.items()) keys.insert(k);
   for (const auto& k : keys) {
     const bool in_was = was.contains(k), in_now = now.contains(k);
     if (in_was && in_now && was[k].is_object() && now[k].is_object()) {
-      list_differences(was[k], now[k], prefix + k + ".", out);
+      list_differences(was[k], now[k], prefix + k + ".", recorded_in, out);
     } else if (!in_was || !in_now || was[k] != now[k]) {
-      out.push_back(prefix + k + " = " + (in_was ? was[k].dump() : "(absent)") +
-                    " in the checkpoint, " + (in_now ? now[k].dump() : "(absent)") + " now");
+      out.push_back(prefix + k + " = " + (in_was ? was[k].dump() : "(absent)") + " in " +
+                    recorded_in + ", " + (in_now ? now[k].dump() : "(absent)") + " now");
     }
   }
 }
@@ -209,13 +244,27 @@ bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json
   return physics_only(checkpoint_case) == physics_only(current_case);
 }
 
-std::string case_differences(const nlohmann::json& checkpoint_case,
-                             const nlohmann::json& current_case) {
+bool completed_under(const nlohmann::json& result_case, const nlohmann::json& current_case) {
+  return physics_only(result_case, false) == physics_only(current_case, false);
+}
+
+namespace {
+// "field = old in RECORDED_IN, new now; ..." (the checkpoint's steps may grow,
+// a result's may not)
+std::string difference_text(const nlohmann::json& recorded_case, const nlohmann::json& current_case,
+                            const std::string& recorded_in, bool steps_may_grow) {
   std::vector<std::string> lines;
-  list_differences(physics_only(checkpoint_case), physics_only(current_case), "", lines);
+  list_differences(physics_only(recorded_case, steps_may_grow),
+                   physics_only(current_case, steps_may_grow), "", recorded_in, lines);
   std::string text;
   for (const auto& l : lines) text += (text.empty() ? "" : "; ") + l;
   return text;
+}
+}  // namespace
+
+std::string case_differences(const nlohmann::json& checkpoint_case,
+                             const nlohmann::json& current_case) {
+  return difference_text(checkpoint_case, current_case, "the checkpoint", true);
 }
 
 RunReport blown_up_run(RunLog& log, const std::string& where, const std::string& what,

@@ -1,7 +1,8 @@
 #pragma once
 // What a run finds in its output directory decides how it starts:
-//   - result.json present: the run is complete; --resume leaves it alone, a
-//     fresh start refuses to overwrite it;
+//   - result.json present: the run is complete; --resume of the same case
+//     leaves it alone (of another case: refused, naming the fields that
+//     differ), a fresh start refuses to overwrite it;
 //   - checkpoint.h5 present: --resume continues from it, a fresh start
 //     refuses (it would silently discard the work);
 //   - otherwise a fresh start. A run removes only files it can prove it
@@ -53,6 +54,10 @@ std::string utc_timestamp();
 // control (threads, progress and checkpoint cadence; for the fluid scene the
 // total number of steps, to extend a run). Everything else must match.
 bool resumable_under(const nlohmann::json& checkpoint_case, const nlohmann::json& current_case);
+// Whether a completed run's result (its recorded case) is the result of the
+// current case: as resumable_under, but every step counts (a completed run is
+// not extended).
+bool completed_under(const nlohmann::json& result_case, const nlohmann::json& current_case);
 // What keeps a checkpoint from being continued: "field = old in the
 // checkpoint, new now" for each differing field, joined by "; ".
 std::string case_differences(const nlohmann::json& checkpoint_case,

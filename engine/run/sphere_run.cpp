@@ -242,7 +242,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
         const auto agg = observables::find_aggregates(
             s.spheres.position, box, 2.0 * (c.numerics.radius_cells + c.derived.well_width));
         output::write_sphere_snapshot(o.out_dir / "spheres", s.step,
-                                      s.step / c.derived.convective_time, s.spheres,
+                                      s.step / c.derived.convective_time, s.spheres, box,
                                       agg.aggregate_of);
       });
     }

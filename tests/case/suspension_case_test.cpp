@@ -14,6 +14,7 @@
 #include "engine/calibration/pair_resistance.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
+#include "engine/output/hdf5_file.hpp"
 #include "engine/output/sphere_snapshots.hpp"
 
 namespace flocsim::cases {
@@ -428,7 +429,9 @@ TEST(SuspensionCase, FixedArrayFromASnapshot) {
   s.radius = 4;
   s.resize(3);
   s.position = {{10, 10, 10}, {20, 10, 10}, {30, 20, 5}};
-  output::write_sphere_snapshot(dir, 7, 0.1, s, {0, 1, 2});
+  spheres::PeriodicBox draft_box;  // draft, a = 4: L = 16a, L/W = 2
+  draft_box.length = {64, 32, 32};
+  output::write_sphere_snapshot(dir, 7, 0.1, s, draft_box, {0, 1, 2});
   const std::string file = output::snapshot_file(dir, 7).string();
   json d = {{"scene", "fixed-array"},
             {"fidelity", "draft"},
@@ -450,17 +453,130 @@ TEST(SuspensionCase, FixedArrayFromASnapshot) {
   wrong["scene"] = "suspension";
   EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("positions_from"), HasSubstr("fixed-array")));
   s.position[1] = {17, 10, 10};  // 7 < 2a apart
-  output::write_sphere_snapshot(dir, 8, 0.1, s, {0, 1, 2});
+  output::write_sphere_snapshot(dir, 8, 0.1, s, draft_box, {0, 1, 2});
   wrong = d;
   wrong["positions_from"] = output::snapshot_file(dir, 8).string();
   EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("spheres 0 and 1 overlap")));
   s.position[1] = {70, 10, 10};  // outside the 64-cell box
-  output::write_sphere_snapshot(dir, 9, 0.1, s, {0, 1, 2});
+  output::write_sphere_snapshot(dir, 9, 0.1, s, draft_box, {0, 1, 2});
   wrong["positions_from"] = output::snapshot_file(dir, 9).string();
   EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("sphere 1 lies outside")));
   wrong["positions_from"] = (dir / "missing.h5").string();
   EXPECT_THAT(refusal(wrong), AllOf(HasSubstr("must be a sphere snapshot")));
   std::filesystem::remove_all(dir);
+}
+
+// The reproducer of the report: a 64 x 32 x 32 snapshot read into a
+// 128 x 64 x 64 box ran at a quarter of its phi with every sphere in one corner.
+TEST(SuspensionCaseRefusals, ASnapshotOfAnotherBoxIsRefusedNamingBothBoxes) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("flocsim_snapshot_box_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  spheres::SphereSet s;
+  s.radius = 4;
+  s.resize(3);
+  s.position = {{10, 10, 10}, {20, 10, 10}, {30, 20, 5}};
+  spheres::PeriodicBox small;
+  small.length = {64, 32, 32};
+  output::write_sphere_snapshot(dir, 7, 0.1, s, small, {0, 1, 2});
+  const std::string file = output::snapshot_file(dir, 7).string();
+  // the snapshot records its box and radius
+  const output::Hdf5File f(file, output::Hdf5File::Mode::read);
+  EXPECT_EQ(f.read<double>("/box"), (std::vector<double>{64, 32, 32}));
+  EXPECT_EQ(f.attribute_double("/", "radius"), 4.0);
+  json d = {{"scene", "fixed-array"},
+            {"fidelity", "draft"},
+            {"positions_from", file},
+            {"numerics", {{"a_over_dx", 4}}}};
+  EXPECT_EQ(parse_suspension_case(d).derived.sphere_count, 3);  // its own box: 64 x 32 x 32
+  json bigger = d;
+  bigger["L_over_a"] = 32;  // 128 x 64 x 64
+  EXPECT_THAT(refusal(bigger), AllOf(HasSubstr("positions_from"), HasSubstr("64 x 32 x 32"),
+                                     HasSubstr("128 x 64 x 64")));
+  // a box given by hand must agree with the one the snapshot records
+  json given = d;
+  given["positions_from_box"] = {128, 64, 64};
+  EXPECT_THAT(refusal(given), AllOf(HasSubstr("positions_from_box"), HasSubstr("64 x 32 x 32")));
+
+  // an older snapshot (no box recorded): refused unless its box is given, and
+  // then only where it is this case's box
+  {
+    output::Hdf5File old(dir / "old.h5", output::Hdf5File::Mode::create);
+    const std::vector<double> x = {10, 10, 10, 20, 10, 10, 30, 20, 5};
+    old.write("/position", {3, 3}, x.data());
+    old.set_attribute("/", "radius", 4.0);
+  }
+  json old = d;
+  old["positions_from"] = (dir / "old.h5").string();
+  EXPECT_THAT(refusal(old), AllOf(HasSubstr("records no box"), HasSubstr("positions_from_box"),
+                                  HasSubstr("64 x 32 x 32")));
+  old["positions_from_box"] = {64, 32, 32};
+  EXPECT_EQ(parse_suspension_case(old).derived.sphere_count, 3);
+  old["L_over_a"] = 32;
+  EXPECT_THAT(refusal(old),
+              AllOf(HasSubstr("positions_from_box = [64 x 32 x 32]"), HasSubstr("128 x 64 x 64")));
+  old.erase("L_over_a");
+  old["positions_from_box"] = {64, 32.5, 32};
+  EXPECT_THAT(refusal(old), HasSubstr("whole numbers"));
+  json without_snapshot = {
+      {"scene", "fixed-array"}, {"phi", 0.1}, {"positions_from_box", {1, 2, 3}}};
+  EXPECT_THAT(refusal(without_snapshot), HasSubstr("only with positions_from"));
+  std::filesystem::remove_all(dir);
+}
+
+// Scenes without lubrication run no model: fixed-array runs recorded
+// "calibrated", and one named in a granular case was recorded as if it had
+// run. A model named there is warned about, and none is recorded.
+TEST(SuspensionCaseRefusals, NoLubricationModelIsRecordedWhereNoneRuns) {
+  for (const char* scene : {"granular", "fixed-array", "single-sphere"}) {
+    SCOPED_TRACE(scene);
+    json base = {{"scene", scene}, {"fidelity", "draft"}};
+    if (std::string(scene) != "single-sphere") base["phi"] = 0.1;
+    auto with = [&](const json& fields) {
+      json d = base;
+      d.merge_patch(fields);
+      return d;
+    };
+    for (const json& d : {base, with({{"lubrication_model", "nguyen-ladd"},
+                                      {"lubrication_integration", "explicit-paper"}})}) {
+      const SuspensionCase c = parse_suspension_case(d);
+      const json recorded = c.to_json();
+      EXPECT_FALSE(recorded.contains("lubrication_model")) << recorded.dump();
+      EXPECT_FALSE(recorded.contains("lubrication_integration")) << recorded.dump();
+      // the recorded case reads back as itself
+      EXPECT_EQ(parse_suspension_case(recorded).to_json(), recorded);
+      std::string warnings;
+      for (const auto& w : c.warnings) warnings += w + "\n";
+      if (d.contains("lubrication_model")) {
+        EXPECT_THAT(warnings,
+                    AllOf(HasSubstr("lubrication_model"), HasSubstr(scene),
+                          HasSubstr("no model runs"), HasSubstr("lubrication_integration")));
+      } else {
+        EXPECT_EQ(warnings.find("lubrication"), std::string::npos) << warnings;
+      }
+    }
+    // a misspelt model is still refused
+    EXPECT_THAT(refusal(with({{"lubrication_model", "calibrate"}})),
+                HasSubstr("lubrication_model"));
+  }
+  // the suspension records the model it runs
+  EXPECT_EQ(parse_suspension_case({{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.1}})
+                .to_json()["lubrication_model"],
+            "calibrated");
+}
+
+// phi 0.3 with one sweep asked for was refused as "{marker_spacing 0.7, sweeps
+// 1} not calibrated ... run flocsim calibrate": the limit is phi, and 0.7 was
+// the default, not the user's.
+TEST(SuspensionCaseRefusals, OneSweepBeyondItsPhiSaysWhyAndMarksDefaults) {
+  const std::string why = refusal({{"scene", "suspension"},
+                                   {"phi", 0.3},
+                                   {"numerics", {{"immersed_boundary", {{"sweeps", 1}}}}}});
+  EXPECT_THAT(why, AllOf(HasSubstr("sweeps 1"), HasSubstr("marker_spacing 0.7 (default)"),
+                         HasSubstr("up to phi = 0.2"), HasSubstr("too little drag"),
+                         HasSubstr("phi = 0.3")));
+  EXPECT_THAT(why, ::testing::Not(HasSubstr("calibrate")));
+  EXPECT_THAT(why, ::testing::Not(HasSubstr("sweeps 1 (default)")));
 }
 
 TEST(SuspensionCaseRefusals, EmptyPositionsFromNamesThePath) {
@@ -553,6 +669,21 @@ TEST(SuspensionCaseCoupling, ControlForcingByHandAndPartiallySaturatedCellsFromT
   EXPECT_NEAR(psm.numerics.input_radius, 3.8958, 1e-4);
   EXPECT_EQ(psm.to_json()["numerics"]["coupling"], "partially-saturated");
   EXPECT_FALSE(psm.to_json()["numerics"].contains("immersed_boundary"));
+}
+
+// The multi-sweep coupling's oscillation floor (a < 6, nu < 0.0133) is the
+// immersed boundary's: partially saturated cells have no sweeps, and a case
+// at a viscosity their table holds (0.01 at a = 4) is accepted as given.
+// Above phi = 0.2, where they were not checked, they are refused naming
+// numerics.coupling.
+TEST(SuspensionCaseCoupling, PartiallySaturatedCellsHaveNoSweepFloorAndAPhiLimit) {
+  const SuspensionCase c = parse_suspension_case(json::parse(R"({"scene": "suspension",
+      "phi": 0.2, "fidelity": "draft",
+      "numerics": {"a_over_dx": 4, "viscosity": 0.01, "coupling": "partially-saturated"}})"));
+  EXPECT_DOUBLE_EQ(c.numerics.viscosity, 0.01);
+  EXPECT_THAT(refusal(json::parse(R"({"scene": "suspension", "phi": 0.25, "fidelity": "draft",
+      "numerics": {"a_over_dx": 4, "viscosity": 0.02, "coupling": "partially-saturated"}})")),
+              AllOf(HasSubstr("numerics.coupling"), HasSubstr("phi = 0.2")));
 }
 
 }  // namespace

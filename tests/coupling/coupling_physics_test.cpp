@@ -84,5 +84,24 @@ TEST(ControlForcing, SettlingSphereGoesUnstableJustBeyondTheAcceptedGains) {
   }
 }
 
+// Galilean invariance: a sphere dragged through the liquid and the same
+// sphere held with the liquid moving past it feel the same drag. The lattice
+// breaks it at O(Ma^2) (5e-4 here) and by where the sphere sits on the grid,
+// which the dragged sphere averages over as it crosses the cells: the held
+// drag is averaged over a node-aligned and a mid-cell place (shifts 0 and
+// 0.5). Within 1 % with direct forcing and partially saturated cells;
+// control forcing, as implemented, does not meet this (11-17 % less drag
+// dragged than held, docs/coupling.md) and is not tested here.
+TEST(GalileanInvariance, DraggedAndHeldSpheresFeelTheSameDrag) {
+  for (const coupling::Scheme& scheme :
+       {coupling::kPaperScheme, coupling::kOneSweepScheme, coupling::kPartiallySaturatedScheme}) {
+    const double dragged = testing_support::drag_at_re1(scheme, false);
+    const double held = 0.5 * (testing_support::drag_at_re1(scheme, true, 0.0) +
+                               testing_support::drag_at_re1(scheme, true, 0.5));
+    std::printf("%s: dragged %.4f, held %.4f\n", scheme.describe().c_str(), dragged, held);
+    EXPECT_NEAR(dragged / held, 1.0, 0.01) << scheme.describe();
+  }
+}
+
 }  // namespace
 }  // namespace flocsim

@@ -102,4 +102,45 @@ inline SettlingOutcome settle_with_control(double ag, double nu, int L, long ste
   return o;
 }
 
+// The drag (in units of 6 pi nu a U) on one sphere (a = 4) moving at U
+// relative to the liquid along a direction off the lattice's axes, in a
+// 32 x 16 x 16 box at nu = 0.1, Re 1, averaged over steps 3000-6000:
+// dragged through liquid at rest, or held with the liquid moving past it at
+// -U (a body force returns to the liquid what the sphere takes, so its mean
+// velocity stays), the held sphere's centre `shift` off the dragged one's
+// start in every direction.
+inline double drag_at_re1(const coupling::Scheme& scheme, bool held, double shift = 0) {
+  const double a = 4, nu = 0.1, U = 1 * nu / (2 * a);
+  const int L = 32, W = 16;
+  const double ag = calibration::CalibrationTable::shipped().input_radius(a, nu, scheme);
+  lattice::FluidLattice<double> fluid({L, W, W}, {nu, 0.25});
+  auto coupling = coupling::make_coupling<double>(scheme, ag);
+  const Vec3 direction = Vec3(1, 0.13, 0.07).normalized();
+  spheres::SphereSet s;
+  s.radius = a;
+  s.resize(1);
+  s.position[0] = Vec3(0.3 * L, 0.5 * W + 0.21, 0.5 * W - 0.37) + Vec3::Constant(shift);
+  if (held) {
+    const Vec3 v = -U * direction;
+    fluid.initialise_equilibrium([&](int, int, int) {
+      return lattice::Macroscopic{1.0, {v.x(), v.y(), v.z()}};
+    });
+  } else {
+    s.velocity[0] = U * direction;
+  }
+  const spheres::PeriodicBox box{Vec3(L, W, W)};
+  double drag = 0;
+  for (int n = 0; n < 6000; ++n) {
+    coupling->apply(fluid, s);
+    fluid.step();
+    coupling->after_liquid_step(fluid, s);
+    const Vec3 back = coupling->force()[0] / (static_cast<double>(L) * W * W);
+    fluid.set_body_force({back.x(), back.y(), back.z()});
+    spheres::advance_positions(s, box);
+    if (n >= 3000)
+      drag -= (coupling->force()[0] + coupling->internal_momentum_change()[0]).dot(direction);
+  }
+  return drag / 3000 / (6 * M_PI * nu * a * U);
+}
+
 }  // namespace flocsim::testing_support

@@ -135,6 +135,20 @@ TEST(SweepErrors, NameTheFieldTheValueAndWhatIsAllowed) {
       0u);
 }
 
+// slurm.partition and slurm.time_limit go into the job script's #SBATCH lines:
+// a line break there started a shell command in the script.
+TEST(SweepErrors, SlurmValuesCannotEndAJobScriptLine) {
+  for (const char* field : {"partition", "time_limit"}) {
+    const std::string file = std::string(R"({"name": "a", "base": {}, "axes": {}, "slurm": {")") +
+                             field + R"(": "debug\ntouch PWNED"}})";
+    EXPECT_NE(error_of(file).find(std::string("slurm.") + field), std::string::npos)
+        << error_of(file);
+    EXPECT_NE(error_of(file).find("one word"), std::string::npos) << error_of(file);
+  }
+  EXPECT_NE(error_of("{\"name\": \"a\\rb\", \"base\": {}, \"axes\": {}}").find("without spaces"),
+            std::string::npos);
+}
+
 TEST(SweepErrors, UnreadableOrInvalidFilesNameTheFile) {
   try {
     orc::read_sweep_file("/nonexistent/sweep.json");

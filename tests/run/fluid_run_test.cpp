@@ -265,6 +265,32 @@ TEST(OutputDirectory, CheckpointsWithoutALubricationModelWereNguyenLadd) {
   EXPECT_TRUE(resumable_under(fixed_old, fixed_now));
 }
 
+TEST(OutputDirectory, ResumingACompletedRunOfAnotherCaseIsRefusedNamingTheField) {
+  // The reproducer of the report: a completed run, the case edited, `--resume`
+  // exited 0 with "already completed" and the old result.
+  const fs::path o = fresh_dir("completed_other_case");
+  ASSERT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 0}).outcome, RunOutcome::completed);
+  const std::string result = text_of(o / "result.json");
+  try {
+    run_fluid_case(small_case(0.06), {o, true, true, 0});
+    ADD_FAILURE() << "a completed run of viscosity 0.05 was reported as the run of 0.06";
+  } catch (const input::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.viscosity = 0.05 in the result, 0.06 now"),
+              std::string::npos)
+        << e.what();
+  }
+  // a completed run is not extended: more steps are another case too
+  cases::FluidCase longer = small_case(0.05);
+  longer.run.steps = 40;
+  EXPECT_THROW(run_fluid_case(longer, {o, true, true, 0}), input::InputError);
+  EXPECT_EQ(text_of(o / "result.json"), result);
+  // the same case, with other run control, is the completed run
+  cases::FluidCase same = small_case(0.05);
+  same.run.threads = 1;
+  EXPECT_EQ(run_fluid_case(same, {o, true, true, 0}).outcome, RunOutcome::completed);
+  fs::remove_all(o);
+}
+
 TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
   // The reproducer of the report: a folder holding the user's spheres/mine.txt
   // and a file called `fields`; the fresh run removed both and exited 0.

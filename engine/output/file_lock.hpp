@@ -1,0 +1,33 @@
+#pragma once
+// An exclusive lock for a read-modify-write of one file by several processes
+// (two `flocsim calibrate` extending one table): the lock is held on a hidden
+// companion file, .NAME.lock in the same folder, which the holder removes
+// when it lets go, so that nothing is left beside the file. A waiter that
+// finds its lock file replaced in the meantime locks the new one: only one
+// process ever holds the lock of a path. Combined with write_file_atomically
+// or TemporaryFile, readers see the old or the new file, writers never lose
+// each other's changes. (A lock is shared with a child forked while it is
+// held, as any flock: fork before taking it.)
+#include <filesystem>
+
+namespace flocsim::output {
+
+class FileLock {
+ public:
+  // Blocks until this process holds the lock of `path`. Throws
+  // std::runtime_error with the system's reason when the lock file cannot be
+  // made (a missing or read-only folder).
+  explicit FileLock(const std::filesystem::path& path);
+  ~FileLock();
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+  // The companion file that carries the lock of `path`.
+  static std::filesystem::path lock_file(const std::filesystem::path& path);
+
+ private:
+  std::filesystem::path lock_path_;
+  int fd_ = -1;
+};
+
+}  // namespace flocsim::output
