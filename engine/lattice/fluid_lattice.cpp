@@ -416,6 +416,7 @@ void FluidLattice<Real>::step_kernel() {
   const Real* const Fys = force_y_.get();
   const Real* const Fzs = force_z_.get();
   SolidCoverage<Real>* const solid = kCoverage ? solid_coverage_ : nullptr;
+  if constexpr (kCoverage) solid->begin_step(omp_get_max_threads());
 
 #pragma omp parallel
   {
@@ -430,150 +431,160 @@ void FluidLattice<Real>::step_kernel() {
     Real* const jx_seen = cover.momentum[0];
     Real* const jy_seen = cover.momentum[1];
     Real* const jz_seen = cover.momentum[2];
+    if constexpr (kCoverage) cover.thread = omp_get_thread_num();
 
-#pragma omp for collapse(2) schedule(static)
-    for (int z = 0; z < nz; ++z)
-      for (int y = 0; y < ny; ++y) {
-        const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
-        // Start of the neighbouring rows (y + dy, z + dz), dy, dz in {-1, 0, 1},
-        // periodic: neighbour_row[dz + 1][dy + 1]. Only unit offsets occur, so
-        // the wrap is a comparison, not an integer division per direction.
-        long neighbour_row[3][3];
-        {
-          const int ys[3] = {y == 0 ? ny - 1 : y - 1, y, y == ny - 1 ? 0 : y + 1};
-          const int zs[3] = {z == 0 ? nz - 1 : z - 1, z, z == nz - 1 ? 0 : z + 1};
-          for (int dz = 0; dz < 3; ++dz)
-            for (int dy = 0; dy < 3; ++dy)
-              neighbour_row[dz][dy] =
-                  static_cast<long>(nx) * (ys[dy] + static_cast<long>(ny) * zs[dz]);
-        }
-        // Per direction: where this row's incoming populations are read and its
-        // outgoing ones written, as pointers indexed by x.
-        const Real* load[kQ];
-        Real* store[kQ];
-        for (int i = 0; i < kQ; ++i) {
-          if (even) {
-            load[i] = base + i * stride + row;
-            store[i] = base + opposite(i) * stride + row;
-          } else {
-            const long up = neighbour_row[1 - cz[i]][1 - cy[i]];
-            const long down = neighbour_row[1 + cz[i]][1 + cy[i]];
-            load[i] = base + opposite(i) * stride + up - cx[i];
-            store[i] = base + i * stride + down + cx[i];
-          }
-        }
-        const Real* Fx = kForceField ? Fxs + row : nullptr;
-        const Real* Fy = kForceField ? Fys + row : nullptr;
-        const Real* Fz = kForceField ? Fzs + row : nullptr;
-
-        auto update = [&](int x, const Real* const* ld, Real* const* st, int lx, int sx)
-                          FLOCSIM_LAMBDA_ALWAYS_INLINE {
-                            Real f[kQ];
-#pragma GCC unroll 19
-                            for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
-                            Real Fcx = bx, Fcy = by, Fcz = bz;
-                            if constexpr (kForceField) {
-                              Fcx += Fx[x];
-                              Fcy += Fy[x];
-                              Fcz += Fz[x];
-                            }
-                            collide(f, Fcx, Fcy, Fcz, k);
-#pragma GCC unroll 19
-                            for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
-                          };
-
-        // A cell that spheres partly cover (partially_saturated_collision.hpp):
-        // it reads its coverage from the row's buffers and leaves there the
-        // density and momentum it saw.
-        auto update_covered = [&](int x, const Real* const* ld, Real* const* st, int lx,
-                                  int sx) FLOCSIM_LAMBDA_ALWAYS_INLINE {
-          Real f[kQ];
-#pragma GCC unroll 19
-          for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
-          Real Fcx = bx, Fcy = by, Fcz = bz;
-          if constexpr (kForceField) {
-            Fcx += Fx[x];
-            Fcy += Fy[x];
-            Fcz += Fz[x];
-          }
-          collide_partially_saturated(f, Fcx, Fcy, Fcz, eps[x], Vx[x], Vy[x], Vz[x], k, rho_seen[x],
-                                      jx_seen[x], jy_seen[x], jz_seen[x]);
-#pragma GCC unroll 19
-          for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
-        };
-
-        const long row_index = static_cast<long>(y) + static_cast<long>(ny) * z;
-        bool covered_row = false;
-        if constexpr (kCoverage) {
-          covered_row = solid->covers(row_index);
-          if (covered_row) {
-            cover.row = row_index;
-            for (int d = 0; d < 3; ++d) cover.force[d] = nullptr;
-            if constexpr (kForceField) {
-              cover.force[0] = Fx;
-              cover.force[1] = Fy;
-              cover.force[2] = Fz;
-            }
-            solid->cover(cover);
-          }
-        }
-        const auto chunk_covered = [&](int x) {
-          constexpr int C = CoveredRow<Real>::kChunk;
-          return covered_row && (cover.chunks[x / C / 64] >> (x / C % 64) & 1);
-        };
-
-        // Interior of the row: every shifted pointer stays inside the row, so
-        // the loop is a plain unit-stride sweep the compiler vectorises.
-        const int x_begin = even ? 0 : 1;
-        const int x_end = even ? nx : nx - 1;
-        if (covered_row) {
-          // span by span: the covered chunks take the blended collision, the
-          // stretches between them the plain one
-          constexpr int C = CoveredRow<Real>::kChunk;
-          for (int x0 = x_begin; x0 < x_end;) {
-            const bool covered = chunk_covered(x0);
-            int x1 = std::min(x_end, (x0 / C + 1) * C);
-            while (x1 < x_end && chunk_covered(x1) == covered) x1 = std::min(x_end, x1 + C);
-            if (covered) {
-#pragma omp simd
-              for (int x = x0; x < x1; ++x) update_covered(x, load, store, x, x);
-            } else {
-#pragma omp simd
-              for (int x = x0; x < x1; ++x) update(x, load, store, x, x);
-            }
-            x0 = x1;
-          }
-        } else {
-#pragma omp simd
-          for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
-        }
-
-        // Odd steps: the two end cells of the row stream across the periodic
-        // boundary in x; give them explicitly wrapped pointers.
-        if (!even) {
-          // the first and the last cell of the row: one cell when nx == 1
-          for (int end = 0; end < (nx == 1 ? 1 : 2); ++end) {
-            const int x = end == 0 ? 0 : nx - 1;
-            const Real* ld[kQ];
-            Real* st[kQ];
-            for (int i = 0; i < kQ; ++i) {
-              const int from = x - cx[i], to = x + cx[i];  // within one cell of the row
-              ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
-              st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
-            }
-            if (chunk_covered(x))
-              update_covered(x, ld, st, 0, 0);
-            else
-              update(x, ld, st, 0, 0);
-          }
-        }
-
-        if constexpr (kCoverage)
-          if (covered_row) {
-            solid->exchange(cover);
-            buffers.reset();
-          }
+    // One lattice row: collision and streaming of cells (0 .. nx - 1, y, z).
+    const auto step_row = [&](int z, int y) FLOCSIM_LAMBDA_ALWAYS_INLINE {
+      const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
+      // Start of the neighbouring rows (y + dy, z + dz), dy, dz in {-1, 0, 1},
+      // periodic: neighbour_row[dz + 1][dy + 1]. Only unit offsets occur, so
+      // the wrap is a comparison, not an integer division per direction.
+      long neighbour_row[3][3];
+      {
+        const int ys[3] = {y == 0 ? ny - 1 : y - 1, y, y == ny - 1 ? 0 : y + 1};
+        const int zs[3] = {z == 0 ? nz - 1 : z - 1, z, z == nz - 1 ? 0 : z + 1};
+        for (int dz = 0; dz < 3; ++dz)
+          for (int dy = 0; dy < 3; ++dy)
+            neighbour_row[dz][dy] =
+                static_cast<long>(nx) * (ys[dy] + static_cast<long>(ny) * zs[dz]);
       }
+      // Per direction: where this row's incoming populations are read and its
+      // outgoing ones written, as pointers indexed by x.
+      const Real* load[kQ];
+      Real* store[kQ];
+      for (int i = 0; i < kQ; ++i) {
+        if (even) {
+          load[i] = base + i * stride + row;
+          store[i] = base + opposite(i) * stride + row;
+        } else {
+          const long up = neighbour_row[1 - cz[i]][1 - cy[i]];
+          const long down = neighbour_row[1 + cz[i]][1 + cy[i]];
+          load[i] = base + opposite(i) * stride + up - cx[i];
+          store[i] = base + i * stride + down + cx[i];
+        }
+      }
+      const Real* Fx = kForceField ? Fxs + row : nullptr;
+      const Real* Fy = kForceField ? Fys + row : nullptr;
+      const Real* Fz = kForceField ? Fzs + row : nullptr;
+
+      auto update = [&](int x, const Real* const* ld, Real* const* st, int lx, int sx)
+                        FLOCSIM_LAMBDA_ALWAYS_INLINE {
+                          Real f[kQ];
+#pragma GCC unroll 19
+                          for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
+                          Real Fcx = bx, Fcy = by, Fcz = bz;
+                          if constexpr (kForceField) {
+                            Fcx += Fx[x];
+                            Fcy += Fy[x];
+                            Fcz += Fz[x];
+                          }
+                          collide(f, Fcx, Fcy, Fcz, k);
+#pragma GCC unroll 19
+                          for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
+                        };
+
+      // A cell that spheres partly cover (partially_saturated_collision.hpp):
+      // it reads its coverage from the row's buffers and leaves there the
+      // density and momentum it saw.
+      auto update_covered = [&](int x, const Real* const* ld, Real* const* st, int lx,
+                                int sx) FLOCSIM_LAMBDA_ALWAYS_INLINE {
+        Real f[kQ];
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) f[i] = ld[i][lx];
+        Real Fcx = bx, Fcy = by, Fcz = bz;
+        if constexpr (kForceField) {
+          Fcx += Fx[x];
+          Fcy += Fy[x];
+          Fcz += Fz[x];
+        }
+        collide_partially_saturated(f, Fcx, Fcy, Fcz, eps[x], Vx[x], Vy[x], Vz[x], k, rho_seen[x],
+                                    jx_seen[x], jy_seen[x], jz_seen[x]);
+#pragma GCC unroll 19
+        for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
+      };
+
+      const long row_index = static_cast<long>(y) + static_cast<long>(ny) * z;
+      bool covered_row = false;
+      if constexpr (kCoverage) {
+        cover.row = row_index;
+        cover.y = y;
+        cover.z = z;
+        for (int d = 0; d < 3; ++d) cover.force[d] = nullptr;
+        if constexpr (kForceField) {
+          cover.force[0] = Fx;
+          cover.force[1] = Fy;
+          cover.force[2] = Fz;
+        }
+        covered_row = solid->cover(cover);
+      }
+      const auto chunk_covered = [&](int x) {
+        constexpr int C = CoveredRow<Real>::kChunk;
+        return covered_row && (cover.chunks[x / C / 64] >> (x / C % 64) & 1);
+      };
+
+      // Interior of the row: every shifted pointer stays inside the row, so
+      // the loop is a plain unit-stride sweep the compiler vectorises.
+      const int x_begin = even ? 0 : 1;
+      const int x_end = even ? nx : nx - 1;
+      if (covered_row) {
+        // span by span: the covered chunks take the blended collision, the
+        // stretches between them the plain one
+        constexpr int C = CoveredRow<Real>::kChunk;
+        for (int x0 = x_begin; x0 < x_end;) {
+          const bool covered = chunk_covered(x0);
+          int x1 = std::min(x_end, (x0 / C + 1) * C);
+          while (x1 < x_end && chunk_covered(x1) == covered) x1 = std::min(x_end, x1 + C);
+          if (covered) {
+#pragma omp simd
+            for (int x = x0; x < x1; ++x) update_covered(x, load, store, x, x);
+          } else {
+#pragma omp simd
+            for (int x = x0; x < x1; ++x) update(x, load, store, x, x);
+          }
+          x0 = x1;
+        }
+      } else {
+#pragma omp simd
+        for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
+      }
+
+      // Odd steps: the two end cells of the row stream across the periodic
+      // boundary in x; give them explicitly wrapped pointers.
+      if (!even) {
+        // the first and the last cell of the row: one cell when nx == 1
+        for (int end = 0; end < (nx == 1 ? 1 : 2); ++end) {
+          const int x = end == 0 ? 0 : nx - 1;
+          const Real* ld[kQ];
+          Real* st[kQ];
+          for (int i = 0; i < kQ; ++i) {
+            const int from = x - cx[i], to = x + cx[i];  // within one cell of the row
+            ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
+            st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
+          }
+          if (chunk_covered(x))
+            update_covered(x, ld, st, 0, 0);
+          else
+            update(x, ld, st, 0, 0);
+        }
+      }
+
+      if constexpr (kCoverage)
+        if (covered_row) {
+          solid->exchange(cover);
+          buffers.reset();
+        }
+    };
+
+    if constexpr (kCoverage) {
+      // each z plane on one thread, its rows in order (forced_liquid.hpp)
+#pragma omp for schedule(static)
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y) step_row(z, y);
+    } else {
+#pragma omp for collapse(2) schedule(static)
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y) step_row(z, y);
+    }
   }
 }
 

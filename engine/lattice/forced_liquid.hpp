@@ -38,12 +38,12 @@ struct ForceFieldView {
 
 // Partially saturated cells (Noble & Torczynski 1998; the collision itself in
 // partially_saturated_collision.hpp) enter the step row by row. The lattice
-// knows nothing of spheres: it lends each row that has covered cells a
-// CoveredRow of row-local buffers, asks a SolidCoverage to fill in the
-// coverage, runs the blended collision on the covered chunks, and hands the
-// density and momentum the collision saw back to the same SolidCoverage,
-// which measures there what the spheres exchanged with the liquid. Nothing
-// lattice-sized is read or written besides the populations.
+// knows nothing of spheres: it lends each row a CoveredRow of row-local
+// buffers, asks a SolidCoverage to fill in the coverage, runs the blended
+// collision on the covered chunks, and hands the density and momentum the
+// collision saw back to the same SolidCoverage, which measures there what
+// the spheres exchanged with the liquid. Nothing lattice-sized is read or
+// written besides the populations.
 //
 // Per cell x of the row (x fastest within the lattice, row r = y + ny z):
 // eps = sum_k eps_k, the summed coverage of the spheres k overlapping the
@@ -59,7 +59,8 @@ struct CoveredRow {
   // slack for vector loops over whole chunks; they stay zero where zero).
   static constexpr int kPad = 16;
   long row = 0;
-  int nx = 0;
+  int y = 0, z = 0, nx = 0;
+  int thread = 0;  // the stepping thread: 0 .. threads - 1 (SolidCoverage::begin_step)
   // Written by the SolidCoverage (they are zero and unmarked on entry):
   std::uint64_t* chunks = nullptr;                        // bit c: chunk c covered
   Real* coverage = nullptr;                               // eps
@@ -74,18 +75,21 @@ struct CoveredRow {
   const Real* force[3] = {nullptr, nullptr, nullptr};
 };
 
-// What the lattice's step asks of the partially saturated cells. The step
-// calls covers() for every row, then cover() and exchange() for those that
-// answer true, from several threads at once on different rows (each row
-// exactly once per step): implementations write nothing shared by two rows.
+// What the lattice's step asks of the partially saturated cells: begin_step()
+// once, then for every row cover(), and exchange() where cover() found
+// covered cells. Rows are stepped by several threads at once, but all rows of
+// one z plane by one thread, in increasing y, each row's cover() and
+// exchange() on the thread that steps it: an implementation may keep state
+// per thread and sum per plane without locks.
 template <class Real>
 class SolidCoverage {
  public:
   virtual ~SolidCoverage() = default;
-  // Whether any cell of lattice row r is covered.
-  virtual bool covers(long row) const = 0;
+  // Before the step's first row: how many threads will step rows.
+  virtual void begin_step(int threads) = 0;
   // Before the row's collision: mark its covered chunks, write eps and V.
-  virtual void cover(CoveredRow<Real>& row) const = 0;
+  // False when no cell of the row is covered (then nothing was written).
+  virtual bool cover(CoveredRow<Real>& row) = 0;
   // After the row's collision: its density and momentum, to measure the
   // momentum exchanged there.
   virtual void exchange(const CoveredRow<Real>& row) = 0;

@@ -8,12 +8,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "engine/coupling/sphere_cells.hpp"
 #include "engine/partially_saturated/cell_coverage.hpp"
 
 namespace flocsim::partially_saturated {
 
-using coupling::wrap;
 using spheres::Vec3;
 
 namespace {
@@ -23,6 +21,20 @@ constexpr int kChunk = lattice::CoveredRow<float>::kChunk;
 // v in [0, n) for v in [-n, 2n).
 int wrap_once(int v, int n) {
   return v < 0 ? v + n : (v >= n ? v - n : v);
+}
+
+// The bins of `row` (0 .. rows - 1) among `bins` that may hold spheres
+// reaching it: its own and the next on either side, each once.
+int neighbour_bins(int row, int rows, int bins, int (&out)[3]) {
+  if (bins < 3) {
+    for (int b = 0; b < bins; ++b) out[b] = b;
+    return bins;
+  }
+  const int b = static_cast<int>(static_cast<long>(row) * bins / rows);
+  out[0] = b == 0 ? bins - 1 : b - 1;
+  out[1] = b;
+  out[2] = b == bins - 1 ? 0 : b + 1;
+  return 3;
 }
 
 // The momentum that one sphere's share of a cell's solid operator gave the
@@ -60,13 +72,15 @@ class LaneSums {
       total_[g] += tree(p[0], p[4], p[2], p[6], p[1], p[5], p[3], p[7]);
     }
   }
-  // The first 12 sums, in order.
+  // Adds the first 12 sums, in order, to those of `out`.
   template <class Sums>
-  void store(Sums& out) const {
+  void add_to(Sums& out) const {
     static_assert(sizeof(Sums) == 12 * sizeof(double), "twelve sums");
-    double all[16];
+    double all[16], sum[12];
     std::memcpy(all, total_, sizeof all);
-    std::memcpy(&out, all, sizeof out);
+    std::memcpy(sum, &out, sizeof sum);
+    for (int i = 0; i < 12; ++i) sum[i] += all[i];
+    std::memcpy(&out, sum, sizeof sum);
   }
 
  private:
@@ -107,185 +121,6 @@ PartiallySaturatedCells<Real>::PartiallySaturatedCells(double input_radius)
 }
 
 template <class Real>
-void PartiallySaturatedCells<Real>::locate(const spheres::SphereSet& spheres,
-                                           const lattice::Extent& e) {
-  const std::size_t n = spheres.size();
-  const int B = box_;
-  const double reach = input_radius_ + kHalfDiagonal;
-  origins_.resize(n);
-  rows_.resize(2 * n * static_cast<std::size_t>(B) * B);
-  sphere_first_.assign(n + 1, 0);
-  sphere_cells_.assign(n + 1, 0);
-  for (std::size_t s = 0; s < n; ++s)
-    for (int d = 0; d < 3; ++d)
-      origins_[s][d] = static_cast<int>(std::floor(spheres.position[s][d] - reach)) - 1;
-      // Per box row: the cells whose centres lie within a_g + sqrt(3)/2 of the
-      // sphere's centre (beyond it cell_coverage() is zero), one run of them,
-      // or two where the row crosses the periodic edge in x. (Dynamic
-      // schedules here: on a busy machine a thread that runs takes over the
-      // spheres of one that waits for a core.)
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::size_t s = 0; s < n; ++s) {
-    const Vec3 centre = spheres.position[s];
-    const auto& lo = origins_[s];
-    const int x_lo = wrap(lo[0], e.nx);
-    std::int16_t* rows = &rows_[2 * s * B * B];
-    std::size_t runs = 0, cells = 0;
-    for (int k = 0; k < B; ++k) {
-      const double rz = lo[2] + k - centre[2];
-      for (int j = 0; j < B; ++j) {
-        const double ry = lo[1] + j - centre[1];
-        const double left = reach * reach - ry * ry - rz * rz;
-        int i0 = 1, i1 = 0;
-        if (left > 0) {
-          const double half = std::sqrt(left);
-          i0 = std::max(0, static_cast<int>(std::ceil(centre[0] - half)) - lo[0]);
-          i1 = std::min(B - 1, static_cast<int>(std::floor(centre[0] + half)) - lo[0]);
-        }
-        rows[2 * (j + B * k)] = static_cast<std::int16_t>(i0);
-        rows[2 * (j + B * k) + 1] = static_cast<std::int16_t>(i1);
-        if (i1 < i0) continue;
-        runs += wrap_once(x_lo + i0, e.nx) + (i1 - i0) >= e.nx ? 2 : 1;
-        cells += static_cast<std::size_t>(i1 - i0 + 1);
-      }
-    }
-    sphere_first_[s + 1] = runs;
-    sphere_cells_[s + 1] = cells;
-  }
-  for (std::size_t s = 0; s < n; ++s) {
-    sphere_first_[s + 1] += sphere_first_[s];
-    sphere_cells_[s + 1] += sphere_cells_[s];
-  }
-}
-
-template <class Real>
-void PartiallySaturatedCells<Real>::list_runs(const spheres::SphereSet& spheres,
-                                              const lattice::Extent& e) {
-  const std::size_t n = spheres.size();
-  const int B = box_;
-  const std::size_t total = sphere_first_[n];
-  slot_runs_.resize(total);
-  slot_row_.resize(total);
-  slot_coverage_.resize(sphere_cells_[n]);
-  const double inner = input_radius_ - kHalfDiagonal;
-#pragma omp parallel
-  {
-    const SphereCoverage coverage(input_radius_);
-    // the cells that need the plane cut (not wholly inside), packed: their
-    // positions, their place in coverage_ and their coverage
-    std::vector<float> rx, ry, rz, cut;
-    std::vector<std::size_t> at;
-    // Sphere by sphere, in the order of its box rows: the slots, and the
-    // coverage of each run's cells.
-#pragma omp for schedule(dynamic, 16)
-    for (std::size_t s = 0; s < n; ++s) {
-      const Vec3 centre = spheres.position[s];
-      const auto& lo = origins_[s];
-      const std::int16_t* rows = &rows_[2 * s * B * B];
-      // the box's corner in the lattice (cells of the box that hold runs lie
-      // less than a box length beyond it, so one wrap suffices)
-      const int x_lo = wrap(lo[0], e.nx), y_lo = wrap(lo[1], e.ny), z_lo = wrap(lo[2], e.nz);
-      std::size_t slot = sphere_first_[s], cell = sphere_cells_[s];
-      const std::size_t most = sphere_cells_[s + 1] - cell;
-      if (rx.size() < most) rx.resize(most), ry.resize(most), rz.resize(most), at.resize(most);
-      int cuts = 0;
-      for (int k = 0; k < B; ++k) {
-        const long plane = static_cast<long>(e.ny) * wrap_once(z_lo + k, e.nz);
-        const double rzd = lo[2] + k - centre[2];
-        for (int j = 0; j < B; ++j) {
-          const int i0 = rows[2 * (j + B * k)], i1 = rows[2 * (j + B * k) + 1];
-          if (i0 > i1) continue;
-          const auto row = static_cast<std::int32_t>(wrap_once(y_lo + j, e.ny) + plane);
-          const double ryd = lo[1] + j - centre[1];
-          Run run;
-          run.sphere = static_cast<std::int32_t>(s);
-          run.ry = static_cast<float>(ryd);
-          run.rz = static_cast<float>(rzd);
-          // cells within a_g - sqrt(3)/2 of the centre are wholly inside,
-          // the others are cut below
-          const double left = inner * inner - ryd * ryd - rzd * rzd;
-          const double half = left > 0 ? std::sqrt(left) : -1.0;
-          for (int i = i0; i <= i1; ++i, ++cell) {
-            const double rxd = lo[0] + i - centre[0];
-            slot_coverage_[cell] = 1.0f;
-            rx[cuts] = static_cast<float>(rxd);
-            ry[cuts] = run.ry;
-            rz[cuts] = run.rz;
-            at[cuts] = cell;
-            cuts += std::abs(rxd) <= half ? 0 : 1;
-          }
-          for (int i = i0; i <= i1;) {  // pieces that do not cross the edge in x
-            const int x = wrap_once(x_lo + i, e.nx);
-            const int count = std::min(i1 - i + 1, e.nx - x);
-            run.x = x;
-            run.count = count;
-            run.rx0 = lo[0] + i - centre[0];
-            run.cell = static_cast<std::int32_t>(cell - static_cast<std::size_t>(i1 - i + 1));
-            slot_runs_[slot] = run;
-            slot_row_[slot++] = row;
-            i += count;
-          }
-        }
-      }
-      if (cut.size() < rx.size()) cut.resize(rx.size());
-      const float *x = rx.data(), *y = ry.data(), *z = rz.data();
-      float* const eps = cut.data();
-#pragma omp simd
-      for (int q = 0; q < cuts; ++q) eps[q] = coverage(x[q], y[q], z[q]);
-      for (int q = 0; q < cuts; ++q) slot_coverage_[at[q]] = eps[q];
-    }
-  }
-  // Then the slots by lattice row (a counting sort: within a row, in slot
-  // order), with where each run's cells will lie in coverage_.
-  const std::size_t rows = static_cast<std::size_t>(e.rows());
-  row_first_.assign(rows + 1, 0);
-  row_cell_first_.assign(rows + 1, 0);
-  for (std::size_t q = 0; q < total; ++q) {
-    const auto r = static_cast<std::size_t>(slot_row_[q]);
-    ++row_first_[r + 1];
-    row_cell_first_[r + 1] += static_cast<std::size_t>(slot_runs_[q].count);
-  }
-  for (std::size_t r = 0; r < rows; ++r) {
-    row_first_[r + 1] += row_first_[r];
-    row_cell_first_[r + 1] += row_cell_first_[r];
-  }
-  next_.assign(row_first_.begin(), row_first_.end() - 1);
-  next_cell_.assign(row_cell_first_.begin(), row_cell_first_.end() - 1);
-  row_slot_.resize(total);
-  row_cell_.resize(total);
-  run_place_.resize(total);
-  for (std::size_t q = 0; q < total; ++q) {
-    const auto r = static_cast<std::size_t>(slot_row_[q]);
-    const std::size_t k = next_[r]++;
-    row_slot_[k] = static_cast<std::int32_t>(q);
-    row_cell_[k] = next_cell_[r];
-    next_cell_[r] += static_cast<std::size_t>(slot_runs_[q].count);
-    run_place_[q] = k;
-  }
-  // Copied into row order, where the step reads them one after the other
-  // (read from their slots during the step they cost it a wait each).
-  runs_.resize(total);
-  sums_.resize(total);
-  coverage_.resize(row_cell_first_[rows] +
-                   kChunk);  // a chunk of slack: the step reads whole chunks
-  const long row_count = static_cast<long>(rows);
-#pragma omp parallel for schedule(dynamic, 64)
-  for (long r = 0; r < row_count; ++r)
-    for (std::size_t k = row_first_[r]; k < row_first_[r + 1]; ++k) {
-      Run run = slot_runs_[static_cast<std::size_t>(row_slot_[k])];
-      std::copy_n(&slot_coverage_[static_cast<std::size_t>(run.cell)], run.count,
-                  &coverage_[row_cell_[k]]);
-      run.cell = static_cast<std::int32_t>(row_cell_[k]);
-      runs_[k] = run;
-    }
-}
-
-template <class Real>
-void PartiallySaturatedCells<Real>::remove(lattice::ForcedLiquid<Real>& liquid) {
-  if (liquid.pending_solid_coverage() == this) liquid.set_solid_coverage(nullptr);
-}
-
-template <class Real>
 void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
                                           const spheres::SphereSet& spheres) {
   const lattice::Extent e = liquid.extent();
@@ -297,29 +132,154 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
           "partially saturated cells: box length " + std::to_string(length[d]) +
           " must exceed 2 (a_g + sqrt(3)/2) = " + std::to_string(2 * reach) +
           " (a sphere must not cover its own periodic image)");
-  locate(spheres, e);
-  list_runs(spheres, e);
-  motion_.resize(spheres.size());
-  for (std::size_t s = 0; s < spheres.size(); ++s) {
+  extent_ = e;
+  const std::size_t n = spheres.size();
+  std::vector<double> centre[3];
+  std::vector<int> corner[3];
+  for (int d = 0; d < 3; ++d) centre[d].resize(n), corner[d].resize(n);
+  motion_.resize(n);
+  // Bins at least a_g + sqrt(3)/2 + 1 wide in y and z: a sphere that reaches
+  // a row lies in the row's bin or a neighbour, a cell clear of their edges.
+  for (int d = 0; d < 2; ++d)
+    bins_[d] = std::max(1, static_cast<int>(std::floor(length[d + 1] / (reach + 1))));
+  bin_first_.assign(static_cast<std::size_t>(bins_[0]) * bins_[1] + 1, 0);
+  std::vector<std::int32_t> bin_of(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    int bin[2];
+    for (int d = 0; d < 3; ++d) {
+      // the centre in the box, its box's corner from there (unwrapped)
+      const double L = length[d];
+      const double c = spheres.position[s][d] - L * std::floor(spheres.position[s][d] / L);
+      centre[d][s] = c;
+      corner[d][s] = static_cast<int>(std::floor(c - reach)) - 1;
+      if (d > 0) bin[d - 1] = std::min(bins_[d - 1] - 1, static_cast<int>(c * bins_[d - 1] / L));
+    }
     const Vec3 u = spheres.velocity[s], w = spheres.angular_velocity[s];
     motion_[s] = {u[0], u[1], u[2], w[0], w[1], w[2]};
+    bin_of[s] = bin[0] + bins_[0] * bin[1];
+    ++bin_first_[static_cast<std::size_t>(bin_of[s]) + 1];
   }
+  for (std::size_t b = 0; b + 1 < bin_first_.size(); ++b) bin_first_[b + 1] += bin_first_[b];
+  std::vector<std::int32_t> next(bin_first_.begin(), bin_first_.end() - 1);
+  binned_.resize(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    Binned& b = binned_[static_cast<std::size_t>(next[static_cast<std::size_t>(bin_of[s])]++)];
+    b.sphere = static_cast<std::int32_t>(s);
+    for (int d = 0; d < 3; ++d) b.corner[d] = corner[d][s], b.centre[d] = centre[d][s];
+  }
+  sums_.assign(n * static_cast<std::size_t>(box_), Sums{});
   body_force_ = liquid.body_force();
   liquid.set_solid_coverage(this);
 }
 
 template <class Real>
-void PartiallySaturatedCells<Real>::cover(lattice::CoveredRow<Real>& row) const {
+void PartiallySaturatedCells<Real>::remove(lattice::ForcedLiquid<Real>& liquid) {
+  if (liquid.pending_solid_coverage() == this) liquid.set_solid_coverage(nullptr);
+}
+
+template <class Real>
+void PartiallySaturatedCells<Real>::begin_step(int threads) {
+  if (static_cast<int>(scratch_.size()) < threads)
+    scratch_.resize(static_cast<std::size_t>(threads));
+}
+
+template <class Real>
+void PartiallySaturatedCells<Real>::find_runs(int y, int z, Scratch& t) const {
+  const lattice::Extent& e = extent_;
+  const int B = box_;
+  const double reach = input_radius_ + kHalfDiagonal, inner = input_radius_ - kHalfDiagonal;
+  t.runs.clear();
+  int ys[3], zs[3];
+  const int ny_bins = neighbour_bins(y, e.ny, bins_[0], ys);
+  const int nz_bins = neighbour_bins(z, e.nz, bins_[1], zs);
+  std::int32_t first = 0;  // in t.eps
+  int cuts = 0;            // cells packed for the plane cut
+  for (int bz = 0; bz < nz_bins; ++bz)
+    for (int by = 0; by < ny_bins; ++by) {
+      const std::size_t bin = static_cast<std::size_t>(ys[by] + bins_[0] * zs[bz]);
+      for (std::int32_t q = bin_first_[bin]; q < bin_first_[bin + 1]; ++q) {
+        const Binned& b = binned_[static_cast<std::size_t>(q)];
+        const int* const lo = b.corner;
+        const double* const c = b.centre;
+        // row (y, z) is row (j, k) of the sphere's box, if any; the cells of
+        // it within a_g + sqrt(3)/2 of the centre are i0 .. i1
+        const int j = wrap_once(y - lo[1], e.ny), k = wrap_once(z - lo[2], e.nz);
+        if (j >= B || k >= B) continue;
+        const double ry = lo[1] + j - c[1], rz = lo[2] + k - c[2];
+        const double left = reach * reach - ry * ry - rz * rz;
+        if (left <= 0) continue;
+        const double half = std::sqrt(left);
+        const int i0 = std::max(0, static_cast<int>(std::ceil(c[0] - half)) - lo[0]);
+        const int i1 = std::min(B - 1, static_cast<int>(std::floor(c[0] + half)) - lo[0]);
+        if (i0 > i1) continue;
+        const int cells = i1 - i0 + 1;
+        if (t.eps.size() < static_cast<std::size_t>(first + cells + kChunk)) {
+          t.eps.resize(2 * static_cast<std::size_t>(first + cells + kChunk));
+          for (auto* v : {&t.rx, &t.ry, &t.rz}) v->resize(t.eps.size());
+          t.at.resize(t.eps.size());
+        }
+        // cells a .. b lie within a_g - sqrt(3)/2 of the centre, wholly
+        // inside; the others are cut below, all at once
+        const double left_in = inner * inner - ry * ry - rz * rz;
+        int a = i1 + 1, b_in = i1;
+        if (left_in > 0) {
+          const double half_in = std::sqrt(left_in);
+          a = std::max(i0, static_cast<int>(std::ceil(c[0] - half_in)) - lo[0]);
+          b_in = std::min(i1, static_cast<int>(std::floor(c[0] + half_in)) - lo[0]);
+          if (a > b_in) a = i1 + 1, b_in = i1;
+        }
+        float* const eps = &t.eps[static_cast<std::size_t>(first)];
+        std::fill_n(eps, cells, 1.0f);
+        const float ry_f = static_cast<float>(ry), rz_f = static_cast<float>(rz);
+        const auto pack = [&](int i) {
+          t.rx[static_cast<std::size_t>(cuts)] = static_cast<float>(lo[0] + i - c[0]);
+          t.ry[static_cast<std::size_t>(cuts)] = ry_f;
+          t.rz[static_cast<std::size_t>(cuts)] = rz_f;
+          t.at[static_cast<std::size_t>(cuts++)] = first + (i - i0);
+        };
+        for (int i = i0; i < a; ++i) pack(i);
+        for (int i = b_in + 1; i <= i1; ++i) pack(i);
+        const std::size_t s = static_cast<std::size_t>(b.sphere);
+        Run run;
+        run.sphere = static_cast<std::int32_t>(s);
+        run.sums = static_cast<std::size_t>(B) * s + static_cast<std::size_t>(k);
+        run.ry = ry_f;
+        run.rz = rz_f;
+        for (int i = i0; i <= i1;) {  // pieces that do not cross the edge in x
+          const int x = wrap_once(lo[0] + i, e.nx);
+          run.x = x;
+          run.count = std::min(i1 - i + 1, e.nx - x);
+          run.first = first + (i - i0);
+          run.rx0 = lo[0] + i - c[0];
+          t.runs.push_back(run);
+          i += run.count;
+        }
+        first += cells;
+      }
+    }
+  if (t.cut.size() < t.rx.size()) t.cut.resize(t.rx.size());
+  const SphereCoverage coverage(input_radius_);
+  const float *px = t.rx.data(), *py = t.ry.data(), *pz = t.rz.data();
+  float* const cut = t.cut.data();
+#pragma omp simd
+  for (int q = 0; q < cuts; ++q) cut[q] = coverage(px[q], py[q], pz[q]);
+  for (int q = 0; q < cuts; ++q) t.eps[static_cast<std::size_t>(t.at[q])] = cut[q];
+}
+
+template <class Real>
+bool PartiallySaturatedCells<Real>::cover(lattice::CoveredRow<Real>& row) {
+  Scratch& t = scratch_[static_cast<std::size_t>(row.thread)];
+  find_runs(row.y, row.z, t);
+  if (t.runs.empty()) return false;
   Real* const eps = row.coverage;
   Real* const V0 = row.solid_velocity[0];
   Real* const V1 = row.solid_velocity[1];
   Real* const V2 = row.solid_velocity[2];
-  for (std::size_t q = row_first_[row.row]; q < row_first_[row.row + 1]; ++q) {
-    const Run& run = runs_[q];
+  for (const Run& run : t.runs) {
     for (int c = run.x / kChunk; c <= (run.x + run.count - 1) / kChunk; ++c)
       row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
-    const std::array<double, 6>& m = motion_[run.sphere];
-    const float* const eps_k = &coverage_[static_cast<std::size_t>(run.cell)];
+    const std::array<double, 6>& m = motion_[static_cast<std::size_t>(run.sphere)];
+    const float* const eps_k = &t.eps[static_cast<std::size_t>(run.first)];
     // whole chunks of the run at a time (the row's buffers have the slack):
     // the cells beyond its end add zero
     for (int w = 0; w < run.count; w += kChunk) {
@@ -336,6 +296,7 @@ void PartiallySaturatedCells<Real>::cover(lattice::CoveredRow<Real>& row) const 
       }
     }
   }
+  return true;
 }
 
 template <class Real>
@@ -349,6 +310,7 @@ void PartiallySaturatedCells<Real>::exchange(const lattice::CoveredRow<Real>& ro
 template <class Real>
 template <bool kForceField>
 void PartiallySaturatedCells<Real>::exchange_runs(const lattice::CoveredRow<Real>& row) {
+  const Scratch& t = scratch_[static_cast<std::size_t>(row.thread)];
   const Real* const eps = row.coverage;
   const Real* const V0 = row.solid_velocity[0];
   const Real* const V1 = row.solid_velocity[1];
@@ -362,19 +324,18 @@ void PartiallySaturatedCells<Real>::exchange_runs(const lattice::CoveredRow<Real
   const Real* const F2 = row.force[2];
   const lattice::Vector3 body = body_force_;
   // per cell of a chunk of the run: what it adds to the run's sums (rows of
-  // RunSums' order; four rows of zeros make two whole groups of eight)
+  // Sums' order; four rows of zeros make two whole groups of eight)
   alignas(64) double q[16][kChunk] = {};
-  for (std::size_t k = row_first_[row.row]; k < row_first_[row.row + 1]; ++k) {
-    const Run& run = runs_[k];
+  for (const Run& run : t.runs) {
     const double y = run.ry, z = run.rz;
-    const float* const eps_k = &coverage_[static_cast<std::size_t>(run.cell)];
+    const float* const eps_k = &t.eps[static_cast<std::size_t>(run.first)];
     LaneSums sums;
     for (int w = 0; w < run.count; w += kChunk) {
       const int x0 = run.x + w, left = run.count - w;
 #pragma omp simd
       for (int c = 0; c < kChunk; ++c) {
         const int x = x0 + c;
-        const bool inside = c < left;
+        const bool inside = c < left;  // the cells beyond the run count nothing
         const double ep = inside ? eps_k[w + c] : 0.0f;
         double f0 = body.x, f1 = body.y, f2 = body.z;
         if constexpr (kForceField) {
@@ -399,15 +360,15 @@ void PartiallySaturatedCells<Real>::exchange_runs(const lattice::CoveredRow<Real
       }
       sums.add(q);
     }
-    sums.store(sums_[k]);
+    sums.add_to(sums_[run.sums]);
   }
 }
 
 template <class Real>
 void PartiallySaturatedCells<Real>::after_liquid_step(const lattice::ForcedLiquid<Real>& liquid,
                                                       const spheres::SphereSet& spheres) {
-  const std::size_t n = spheres.size();
-  if (sphere_first_.size() != n + 1)
+  const std::size_t n = spheres.size(), B = static_cast<std::size_t>(box_);
+  if (sums_.size() != n * B)
     throw std::logic_error("partially saturated cells: after_liquid_step() without apply()");
   if (liquid.pending_solid_coverage() == this)
     throw std::logic_error(
@@ -415,12 +376,11 @@ void PartiallySaturatedCells<Real>::after_liquid_step(const lattice::ForcedLiqui
   this->force_.assign(n, Vec3::Zero());
   this->torque_.assign(n, Vec3::Zero());
   std::vector<Vec3> momentum(n, Vec3::Zero()), angular(n, Vec3::Zero());
-  // each sphere's runs in a fixed order (its box rows')
-#pragma omp parallel for schedule(dynamic, 16)
+  // each sphere's planes in order
   for (std::size_t s = 0; s < n; ++s) {
     Vec3 dP = Vec3::Zero(), r_dP = Vec3::Zero(), P = Vec3::Zero(), r_P = Vec3::Zero();
-    for (std::size_t q = sphere_first_[s]; q < sphere_first_[s + 1]; ++q) {
-      const RunSums& m = sums_[run_place_[q]];
+    for (std::size_t k = 0; k < B; ++k) {
+      const Sums& m = sums_[B * s + k];
       dP += Vec3(m.dP[0], m.dP[1], m.dP[2]);
       r_dP += Vec3(m.r_dP[0], m.r_dP[1], m.r_dP[2]);
       P += Vec3(m.P[0], m.P[1], m.P[2]);

@@ -12,18 +12,19 @@
 // liquid's momentum is sum eps_k rho u over the sphere's cells. Liquid and
 // spheres then exchange exactly the same momentum.
 //
-// How it enters the step (the lattice knows no sphere, forced_liquid.hpp):
-// apply() lists, per lattice row, the runs of cells that each sphere may
-// cover (the cells whose centres lie within a_g + sqrt(3)/2 of its centre, a
-// row meets a few spheres) and hands itself to the lattice as the row-wise
-// SolidCoverage of the next step. For each row with runs the step asks it to
-// write the coverage and solid velocity into the row's buffers (the coverage
-// computed there, in cache), collides, and hands back the density and
-// momentum the collision saw; the sums of the exchange over each run (force,
-// torque, inside momenta) are taken right there. after_liquid_step() adds
-// each sphere's runs up. Every run has its own slot for its sums and each
-// sphere adds its runs in a fixed order, so a run of the solver is
-// reproducible whatever the number of threads and their schedule.
+// How it enters the step (the lattice knows no sphere: forced_liquid.hpp's
+// SolidCoverage): apply() only bins the spheres by where they lie across the
+// rows (y, z) and hands itself to the lattice for the next step. For each
+// lattice row the step asks cover(): the row's runs of cells that each
+// nearby sphere may cover (the cells whose centres lie within
+// a_g + sqrt(3)/2 of its centre) are found from the bins, their coverage
+// computed and the coverage and solid velocity written into the row's
+// buffers, all in cache; after the row's collision exchange() sums each run's
+// share of the exchange (force, torque, inside momenta) into its sphere's
+// entry for that z plane. after_liquid_step() adds each sphere's planes up.
+// A plane is stepped by one thread in a fixed order, and every sum is taken
+// in an order fixed by the geometry alone, so a run is reproducible whatever
+// the number of threads.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -52,63 +53,66 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
 
  private:
   // The lattice's side (lattice::SolidCoverage), called during its step.
-  bool covers(long row) const override { return row_first_[row + 1] > row_first_[row]; }
-  void cover(lattice::CoveredRow<Real>& row) const override;
+  void begin_step(int threads) override;
+  bool cover(lattice::CoveredRow<Real>& row) override;
   void exchange(const lattice::CoveredRow<Real>& row) override;
 
-  // The cells x .. x + count - 1 of one lattice row that one sphere may
-  // cover, and where they lie from its centre: cell x + c at
-  // (rx0 + c, ry, rz) (positions rounded to single precision as they enter
-  // the coverage).
+  // The cells x .. x + count - 1 of the row being stepped that one sphere may
+  // cover, where they lie from its centre (cell x + c at (rx0 + c, ry, rz),
+  // rounded to single precision as they enter the coverage), where their
+  // coverage is in the thread's scratch, and the sphere's entry for this
+  // plane of its box (sums_).
   struct Run {
     std::int32_t sphere = 0;
     std::int32_t x = 0, count = 0;
-    std::int32_t cell = 0;  // the coverage of its cells: coverage_[cell ..]
-    float ry = 0, rz = 0;
+    std::int32_t first = 0;  // coverage: Scratch::eps[first ..]
+    std::size_t sums = 0;
     double rx0 = 0;
+    float ry = 0, rz = 0;
   };
-  // What the liquid's step measured over one run: the momentum its sphere's
-  // share of the solid operator gave the liquid (dP), r x dP, eps_k rho u
-  // and r x eps_k rho u, summed over the run's cells.
-  struct RunSums {
+  // Per thread, for the row it steps: its runs and their cells' coverage,
+  // and the cells that need the plane cut (not wholly inside), packed.
+  struct Scratch {
+    std::vector<Run> runs;
+    std::vector<float> eps;
+    std::vector<float> rx, ry, rz, cut;
+    std::vector<std::int32_t> at;
+  };
+  // What the step measured for one sphere in one plane of its box: the
+  // momentum the sphere's share of the solid operator gave the liquid (dP),
+  // r x dP, eps_k rho u and r x eps_k rho u, summed over its cells there.
+  struct Sums {
     double dP[3], r_dP[3], P[3], r_P[3];
   };
 
-  // Each sphere's box of cells and its rows of possibly covered cells
-  // (sphere_cells.hpp layout), and how many runs they make.
-  void locate(const spheres::SphereSet& spheres, const lattice::Extent& e);
-  // The runs, sphere by sphere (slot order), then by lattice row.
-  void list_runs(const spheres::SphereSet& spheres, const lattice::Extent& e);
+  // Finds the runs of row (y, z) into `t` and their cells' coverage.
+  void find_runs(int y, int z, Scratch& t) const;
   template <bool kForceField>
   void exchange_runs(const lattice::CoveredRow<Real>& row);
 
   double input_radius_;
-  int box_ = 0;
-  std::vector<std::array<int, 3>> origins_;
-  std::vector<std::int16_t> rows_;
-  // The runs as apply() lists them, by slot: sphere s's are slots
-  // sphere_first_[s] .. sphere_first_[s + 1] - 1, in the order of its box
-  // rows; their lattice rows; their cells' coverage (sphere s's from
-  // sphere_cells_[s]).
-  std::vector<std::size_t> sphere_first_, sphere_cells_;
-  std::vector<Run> slot_runs_;
-  std::vector<std::int32_t> slot_row_;
-  std::vector<float> slot_coverage_;
-  // The same in the order the step reads them: lattice row r's runs are
-  // runs_[row_first_[r] .. row_first_[r + 1] - 1], in slot order (so in the
-  // order of their spheres), their cells' coverage in coverage_ (row r's
-  // from row_cell_first_[r]); the slot of each and the place of each slot.
-  std::vector<std::size_t> row_first_, row_cell_first_;
-  std::vector<Run> runs_;
-  std::vector<float> coverage_;
-  std::vector<std::int32_t> row_slot_;
-  std::vector<std::size_t> row_cell_, run_place_;
-  std::vector<std::size_t> next_, next_cell_;  // (counting sort's cursors)
-  // What each run measured, in row order (the step writes them one after
-  // the other; slot q's are sums_[run_place_[q]]).
-  std::vector<RunSums> sums_;
-  std::vector<std::array<double, 6>> motion_;  // per sphere: u_p, omega
+  int box_ = 0;  // B: a sphere's cells lie in a box of B^3 from its corner
+  lattice::Extent extent_;
+  // per sphere: u_p and omega
+  std::vector<std::array<double, 6>> motion_;
+  // The spheres binned by their centres' (y, z): bin (b, c) of bins_[0] x
+  // bins_[1] holds binned_[bin_first_[b + bins_[0] c] .. next - 1], in index
+  // order, with the centre (in the box) and the lowest corner of the box of
+  // B^3 cells around it (unwrapped). Bins are at least a_g + sqrt(3)/2 + 1
+  // wide, so the spheres that reach a row lie in its bin or the ones next to
+  // it.
+  struct Binned {
+    std::int32_t sphere;
+    std::int32_t corner[3];
+    double centre[3];
+  };
+  int bins_[2] = {1, 1};
+  std::vector<std::int32_t> bin_first_;
+  std::vector<Binned> binned_;
+  // sums_[B s + k]: sphere s's, plane k of its box
+  std::vector<Sums> sums_;
   lattice::Vector3 body_force_;
+  std::vector<Scratch> scratch_;  // per thread
 };
 
 extern template class PartiallySaturatedCells<float>;

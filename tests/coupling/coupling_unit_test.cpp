@@ -131,14 +131,15 @@ class UniformCoverage final : public lattice::SolidCoverage<Real> {
   std::vector<double> density;
   std::array<std::vector<double>, 3> momentum;
 
-  bool covers(long) const override { return true; }
-  void cover(lattice::CoveredRow<Real>& row) const override {
+  void begin_step(int) override {}
+  bool cover(lattice::CoveredRow<Real>& row) override {
     for (int x = 0; x < row.nx; ++x) {
       const int c = x / lattice::CoveredRow<Real>::kChunk;
       row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
       row.coverage[x] = static_cast<Real>(eps_);
       for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = static_cast<Real>(eps_ * velocity[d]);
     }
+    return true;
   }
   void exchange(const lattice::CoveredRow<Real>& row) override {
     const std::size_t at = static_cast<std::size_t>(row.row) * row.nx;

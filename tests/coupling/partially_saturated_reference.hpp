@@ -114,18 +114,20 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   }
 
   // lattice::SolidCoverage: the rows' slices of the arrays
-  bool covers(long row) const override {
-    for (int w = 0; w < chunk_words_; ++w)
-      if (chunks_[row * chunk_words_ + w]) return true;
-    return false;
-  }
-  void cover(lattice::CoveredRow<Real>& row) const override {
-    for (int w = 0; w < chunk_words_; ++w) row.chunks[w] = chunks_[row.row * chunk_words_ + w];
+  void begin_step(int) override {}
+  bool cover(lattice::CoveredRow<Real>& row) override {
+    bool any = false;
+    for (int w = 0; w < chunk_words_; ++w) {
+      row.chunks[w] = chunks_[row.row * chunk_words_ + w];
+      any = any || row.chunks[w] != 0;
+    }
+    if (!any) return false;
     const std::size_t at = static_cast<std::size_t>(row.row) * nx_;
     for (int x = 0; x < nx_; ++x) {
       row.coverage[x] = coverage_[at + x];
       for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = solid_velocity_[d][at + x];
     }
+    return true;
   }
   void exchange(const lattice::CoveredRow<Real>& row) override {
     const std::size_t at = static_cast<std::size_t>(row.row) * nx_;
