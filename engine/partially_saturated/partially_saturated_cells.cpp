@@ -16,25 +16,15 @@ using spheres::Vec3;
 
 namespace {
 constexpr double kHalfDiagonal = 0.8660254037844386;  // sqrt(3) / 2
-constexpr int kChunk = lattice::CoveredRow<float>::kChunk;
+// Runs of cells are swept in blocks of kLanes (the row's buffers have the
+// slack for a last whole block, lattice::CoveredRow::kPad): one vector of
+// floats, two of doubles.
+constexpr int kLanes = 16;
+static_assert(lattice::CoveredRow<float>::kPad >= kLanes, "slack for a whole block");
 
 // v in [0, n) for v in [-n, 2n).
 int wrap_once(int v, int n) {
   return v < 0 ? v + n : (v >= n ? v - n : v);
-}
-
-// The bins of `row` (0 .. rows - 1) among `bins` that may hold spheres
-// reaching it: its own and the next on either side, each once.
-int neighbour_bins(int row, int rows, int bins, int (&out)[3]) {
-  if (bins < 3) {
-    for (int b = 0; b < bins; ++b) out[b] = b;
-    return bins;
-  }
-  const int b = static_cast<int>(static_cast<long>(row) * bins / rows);
-  out[0] = b == 0 ? bins - 1 : b - 1;
-  out[1] = b;
-  out[2] = b == bins - 1 ? 0 : b + 1;
-  return 3;
 }
 
 // The momentum that one sphere's share of a cell's solid operator gave the
@@ -53,17 +43,17 @@ inline void exchange_share(double eps_k, double eps, double rho, double V0, doub
   d2 = share * (rho_over * V2 - j2 - f2);
 }
 
-// Sums of 16 rows of one chunk's lanes, q[i][0] + ... + q[i][kChunk - 1],
+// Sums of 16 rows of one chunk's lanes, q[i][0] + ... + q[i][kLanes - 1],
 // accumulated over a run's chunks. One sum per row would end every run in
 // 12 horizontal reductions (most of exchange()'s time); a tree of
 // shuffles and adds sums eight rows at once instead.
 class LaneSums {
  public:
-  static_assert(kChunk == 16, "two groups of eight lanes per chunk");
+  static_assert(kLanes == 16, "two groups of eight lanes per chunk");
   typedef double V8 __attribute__((vector_size(64)));
   typedef long long I8 __attribute__((vector_size(64)));
 
-  void add(const double (&q)[16][kChunk]) {
+  void add(const double (&q)[16][kLanes]) {
     V8 v[16];
     for (int i = 0; i < 16; ++i) v[i] = load(q[i]) + load(q[i] + 8);
     // the tree's output lanes hold the totals of its inputs 0, 4, 2, 6, 1, 5, 3, 7
@@ -134,39 +124,73 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
           " (a sphere must not cover its own periodic image)");
   extent_ = e;
   const std::size_t n = spheres.size();
-  std::vector<double> centre[3];
-  std::vector<int> corner[3];
-  for (int d = 0; d < 3; ++d) centre[d].resize(n), corner[d].resize(n);
+  const int B = box_;
   motion_.resize(n);
-  // Bins at least a_g + sqrt(3)/2 + 1 wide in y and z: a sphere that reaches
-  // a row lies in the row's bin or a neighbour, a cell clear of their edges.
-  for (int d = 0; d < 2; ++d)
-    bins_[d] = std::max(1, static_cast<int>(std::floor(length[d + 1] / (reach + 1))));
-  bin_first_.assign(static_cast<std::size_t>(bins_[0]) * bins_[1] + 1, 0);
-  std::vector<std::int32_t> bin_of(n);
   for (std::size_t s = 0; s < n; ++s) {
-    int bin[2];
-    for (int d = 0; d < 3; ++d) {
-      // the centre in the box, its box's corner from there (unwrapped)
-      const double L = length[d];
-      const double c = spheres.position[s][d] - L * std::floor(spheres.position[s][d] / L);
-      centre[d][s] = c;
-      corner[d][s] = static_cast<int>(std::floor(c - reach)) - 1;
-      if (d > 0) bin[d - 1] = std::min(bins_[d - 1] - 1, static_cast<int>(c * bins_[d - 1] / L));
-    }
     const Vec3 u = spheres.velocity[s], w = spheres.angular_velocity[s];
     motion_[s] = {u[0], u[1], u[2], w[0], w[1], w[2]};
-    bin_of[s] = bin[0] + bins_[0] * bin[1];
-    ++bin_first_[static_cast<std::size_t>(bin_of[s]) + 1];
   }
-  for (std::size_t b = 0; b + 1 < bin_first_.size(); ++b) bin_first_[b + 1] += bin_first_[b];
-  std::vector<std::int32_t> next(bin_first_.begin(), bin_first_.end() - 1);
-  binned_.resize(n);
+  // Bands at least max(8, a_g + sqrt(3)/2) rows wide: a slice's rows (at most
+  // 2 (a_g + sqrt(3)/2) + 1 of them) meet at most three bands.
+  bands_ = std::max(1, static_cast<int>(e.ny / std::max(8.0, reach)));
+  band_of_row_.resize(static_cast<std::size_t>(e.ny));
+  for (int y = 0; y < e.ny; ++y)
+    band_of_row_[static_cast<std::size_t>(y)] =
+        static_cast<std::int32_t>(static_cast<long>(y) * bands_ / e.ny);
+  // Each sphere's slices with the bands they meet, counted per band; then
+  // placed band by band (in sphere order within a band).
+  band_first_.assign(static_cast<std::size_t>(bands_) * e.nz + 1, 0);
+  listed_.clear();
   for (std::size_t s = 0; s < n; ++s) {
-    Binned& b = binned_[static_cast<std::size_t>(next[static_cast<std::size_t>(bin_of[s])]++)];
-    b.sphere = static_cast<std::int32_t>(s);
-    for (int d = 0; d < 3; ++d) b.corner[d] = corner[d][s], b.centre[d] = centre[d][s];
+    // the centre in the box, its box's lowest corner from there (unwrapped)
+    double c[3];
+    int lo[3];
+    for (int d = 0; d < 3; ++d) {
+      const double L = length[d];
+      c[d] = spheres.position[s][d] - L * std::floor(spheres.position[s][d] / L);
+      lo[d] = static_cast<int>(std::floor(c[d] - reach)) - 1;
+    }
+    for (int k = 0; k < B; ++k) {
+      const double rz = lo[2] + k - c[2];
+      const double left = reach * reach - rz * rz;
+      if (left <= 0) continue;
+      const double half = std::sqrt(left);
+      const int j0 = std::max(0, static_cast<int>(std::ceil(c[1] - half)) - lo[1]);
+      const int j1 = std::min(B - 1, static_cast<int>(std::floor(c[1] + half)) - lo[1]);
+      if (j0 > j1) continue;
+      Listed l;
+      l.slice = {static_cast<std::int32_t>(s), k, lo[0], lo[1], j0, j1, c[0], c[1], rz};
+      l.z = wrap_once(lo[2] + k, e.nz);
+      // the bands its rows y0 .. y1 meet, each once (the rows wrap into at
+      // most two stretches)
+      const int y0 = wrap_once(lo[1] + j0, e.ny), y1 = wrap_once(lo[1] + j1, e.ny);
+      const auto add_bands = [&](int from, int to) {
+        for (int b = band_of_row_[static_cast<std::size_t>(from)];
+             b <= band_of_row_[static_cast<std::size_t>(to)]; ++b) {
+          if (std::find(l.bands, l.bands + l.count, b) != l.bands + l.count) continue;
+          if (l.count == 3)
+            throw std::logic_error("partially saturated cells: a slice meets more than 3 bands");
+          l.bands[l.count++] = b;
+        }
+      };
+      if (y0 <= y1) {
+        add_bands(y0, y1);
+      } else {
+        add_bands(y0, e.ny - 1);
+        add_bands(0, y1);
+      }
+      for (int q = 0; q < l.count; ++q)
+        ++band_first_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z) + 1];
+      listed_.push_back(l);
+    }
   }
+  for (std::size_t b = 0; b + 1 < band_first_.size(); ++b) band_first_[b + 1] += band_first_[b];
+  next_.assign(band_first_.begin(), band_first_.end() - 1);
+  slices_.resize(static_cast<std::size_t>(band_first_.back()));
+  for (const Listed& l : listed_)
+    for (int q = 0; q < l.count; ++q)
+      slices_[static_cast<std::size_t>(
+          next_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z)]++)] = l.slice;
   sums_.assign(n * static_cast<std::size_t>(box_), Sums{});
   body_force_ = liquid.body_force();
   liquid.set_solid_coverage(this);
@@ -189,80 +213,83 @@ void PartiallySaturatedCells<Real>::find_runs(int y, int z, Scratch& t) const {
   const int B = box_;
   const double reach = input_radius_ + kHalfDiagonal, inner = input_radius_ - kHalfDiagonal;
   t.runs.clear();
-  int ys[3], zs[3];
-  const int ny_bins = neighbour_bins(y, e.ny, bins_[0], ys);
-  const int nz_bins = neighbour_bins(z, e.nz, bins_[1], zs);
   std::int32_t first = 0;  // in t.eps
   int cuts = 0;            // cells packed for the plane cut
-  for (int bz = 0; bz < nz_bins; ++bz)
-    for (int by = 0; by < ny_bins; ++by) {
-      const std::size_t bin = static_cast<std::size_t>(ys[by] + bins_[0] * zs[bz]);
-      for (std::int32_t q = bin_first_[bin]; q < bin_first_[bin + 1]; ++q) {
-        const Binned& b = binned_[static_cast<std::size_t>(q)];
-        const int* const lo = b.corner;
-        const double* const c = b.centre;
-        // row (y, z) is row (j, k) of the sphere's box, if any; the cells of
-        // it within a_g + sqrt(3)/2 of the centre are i0 .. i1
-        const int j = wrap_once(y - lo[1], e.ny), k = wrap_once(z - lo[2], e.nz);
-        if (j >= B || k >= B) continue;
-        const double ry = lo[1] + j - c[1], rz = lo[2] + k - c[2];
-        const double left = reach * reach - ry * ry - rz * rz;
-        if (left <= 0) continue;
-        const double half = std::sqrt(left);
-        const int i0 = std::max(0, static_cast<int>(std::ceil(c[0] - half)) - lo[0]);
-        const int i1 = std::min(B - 1, static_cast<int>(std::floor(c[0] + half)) - lo[0]);
-        if (i0 > i1) continue;
-        const int cells = i1 - i0 + 1;
-        if (t.eps.size() < static_cast<std::size_t>(first + cells + kChunk)) {
-          t.eps.resize(2 * static_cast<std::size_t>(first + cells + kChunk));
-          for (auto* v : {&t.rx, &t.ry, &t.rz}) v->resize(t.eps.size());
-          t.at.resize(t.eps.size());
-        }
-        // cells a .. b lie within a_g - sqrt(3)/2 of the centre, wholly
-        // inside; the others are cut below, all at once
-        const double left_in = inner * inner - ry * ry - rz * rz;
-        int a = i1 + 1, b_in = i1;
-        if (left_in > 0) {
-          const double half_in = std::sqrt(left_in);
-          a = std::max(i0, static_cast<int>(std::ceil(c[0] - half_in)) - lo[0]);
-          b_in = std::min(i1, static_cast<int>(std::floor(c[0] + half_in)) - lo[0]);
-          if (a > b_in) a = i1 + 1, b_in = i1;
-        }
-        float* const eps = &t.eps[static_cast<std::size_t>(first)];
-        std::fill_n(eps, cells, 1.0f);
-        const float ry_f = static_cast<float>(ry), rz_f = static_cast<float>(rz);
-        const auto pack = [&](int i) {
-          t.rx[static_cast<std::size_t>(cuts)] = static_cast<float>(lo[0] + i - c[0]);
-          t.ry[static_cast<std::size_t>(cuts)] = ry_f;
-          t.rz[static_cast<std::size_t>(cuts)] = rz_f;
-          t.at[static_cast<std::size_t>(cuts++)] = first + (i - i0);
-        };
-        for (int i = i0; i < a; ++i) pack(i);
-        for (int i = b_in + 1; i <= i1; ++i) pack(i);
-        const std::size_t s = static_cast<std::size_t>(b.sphere);
-        Run run;
-        run.sphere = static_cast<std::int32_t>(s);
-        run.sums = static_cast<std::size_t>(B) * s + static_cast<std::size_t>(k);
-        run.ry = ry_f;
-        run.rz = rz_f;
-        for (int i = i0; i <= i1;) {  // pieces that do not cross the edge in x
-          const int x = wrap_once(lo[0] + i, e.nx);
-          run.x = x;
-          run.count = std::min(i1 - i + 1, e.nx - x);
-          run.first = first + (i - i0);
-          run.rx0 = lo[0] + i - c[0];
-          t.runs.push_back(run);
-          i += run.count;
-        }
-        first += cells;
-      }
+  const std::size_t band = static_cast<std::size_t>(static_cast<long>(y) * bands_ / e.ny +
+                                                    static_cast<long>(bands_) * z);
+  for (std::int32_t q = band_first_[band]; q < band_first_[band + 1]; ++q) {
+    const Slice& slice = slices_[static_cast<std::size_t>(q)];
+    // row y is row j of the sphere's box; the cells of it within
+    // a_g + sqrt(3)/2 of the centre are i0 .. i1
+    const int j = wrap_once(y - slice.corner_y, e.ny);
+    if (j < slice.j0 || j > slice.j1) continue;
+    const double ry = slice.corner_y + j - slice.centre_y, rz = slice.rz;
+    const double left = reach * reach - ry * ry - rz * rz;
+    if (left <= 0) continue;
+    const double cx = slice.centre_x;
+    const int lo_x = slice.corner_x;
+    const double half = std::sqrt(left);
+    const int i0 = std::max(0, static_cast<int>(std::ceil(cx - half)) - lo_x);
+    const int i1 = std::min(B - 1, static_cast<int>(std::floor(cx + half)) - lo_x);
+    if (i0 > i1) continue;
+    const int cells = i1 - i0 + 1;
+    if (t.eps.size() < static_cast<std::size_t>(first + cells + kLanes)) {
+      t.eps.resize(2 * static_cast<std::size_t>(first + cells + kLanes));
+      for (auto* v : {&t.rx, &t.ry, &t.rz}) v->resize(t.eps.size());
+      t.at.resize(t.eps.size());
     }
+    // cells a .. b lie within a_g - sqrt(3)/2 of the centre, wholly
+    // inside; the others are cut below, all at once
+    const double left_in = inner * inner - ry * ry - rz * rz;
+    int a = i1 + 1, b_in = i1;
+    if (left_in > 0) {
+      const double half_in = std::sqrt(left_in);
+      a = std::max(i0, static_cast<int>(std::ceil(cx - half_in)) - lo_x);
+      b_in = std::min(i1, static_cast<int>(std::floor(cx + half_in)) - lo_x);
+      if (a > b_in) a = i1 + 1, b_in = i1;
+    }
+    float* const eps = &t.eps[static_cast<std::size_t>(first)];
+    std::fill_n(eps, cells, 1.0f);
+    const float ry_f = static_cast<float>(ry), rz_f = static_cast<float>(rz);
+    const auto pack = [&](int i) {
+      t.rx[static_cast<std::size_t>(cuts)] = static_cast<float>(lo_x + i - cx);
+      t.ry[static_cast<std::size_t>(cuts)] = ry_f;
+      t.rz[static_cast<std::size_t>(cuts)] = rz_f;
+      t.at[static_cast<std::size_t>(cuts++)] = first + (i - i0);
+    };
+    for (int i = i0; i < a; ++i) pack(i);
+    for (int i = b_in + 1; i <= i1; ++i) pack(i);
+    const std::size_t s = static_cast<std::size_t>(slice.sphere);
+    Run run;
+    run.sphere = static_cast<std::int32_t>(s);
+    run.sums = static_cast<std::size_t>(B) * s + static_cast<std::size_t>(slice.plane);
+    run.ry = ry_f;
+    run.rz = rz_f;
+    for (int i = i0; i <= i1;) {  // pieces that do not cross the edge in x
+      const int x = wrap_once(lo_x + i, e.nx);
+      run.x = x;
+      run.count = std::min(i1 - i + 1, e.nx - x);
+      run.first = first + (i - i0);
+      run.rx0 = lo_x + i - cx;
+      t.runs.push_back(run);
+      i += run.count;
+    }
+    first += cells;
+  }
   if (t.cut.size() < t.rx.size()) t.cut.resize(t.rx.size());
+  // whole blocks of lanes (the arrays have the slack; the cells beyond the
+  // last are the sphere's centre, computed and dropped): a scalar remainder
+  // loop of a few cells per row would take as long as the vector loop
+  const int blocks = (cuts + kLanes - 1) / kLanes * kLanes;
+  for (int q = cuts; q < blocks; ++q) {
+    const std::size_t u = static_cast<std::size_t>(q);
+    t.rx[u] = t.ry[u] = t.rz[u] = 0.0f;
+  }
   const SphereCoverage coverage(input_radius_);
   const float *px = t.rx.data(), *py = t.ry.data(), *pz = t.rz.data();
   float* const cut = t.cut.data();
 #pragma omp simd
-  for (int q = 0; q < cuts; ++q) cut[q] = coverage(px[q], py[q], pz[q]);
+  for (int q = 0; q < blocks; ++q) cut[q] = coverage(px[q], py[q], pz[q]);
   for (int q = 0; q < cuts; ++q) t.eps[static_cast<std::size_t>(t.at[q])] = cut[q];
 }
 
@@ -276,16 +303,17 @@ bool PartiallySaturatedCells<Real>::cover(lattice::CoveredRow<Real>& row) {
   Real* const V1 = row.solid_velocity[1];
   Real* const V2 = row.solid_velocity[2];
   for (const Run& run : t.runs) {
-    for (int c = run.x / kChunk; c <= (run.x + run.count - 1) / kChunk; ++c)
+    constexpr int C = lattice::CoveredRow<Real>::kChunk;
+    for (int c = run.x / C; c <= (run.x + run.count - 1) / C; ++c)
       row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
     const std::array<double, 6>& m = motion_[static_cast<std::size_t>(run.sphere)];
     const float* const eps_k = &t.eps[static_cast<std::size_t>(run.first)];
     // whole chunks of the run at a time (the row's buffers have the slack):
     // the cells beyond its end add zero
-    for (int w = 0; w < run.count; w += kChunk) {
+    for (int w = 0; w < run.count; w += kLanes) {
       const int x0 = run.x + w, left = run.count - w;
 #pragma omp simd
-      for (int c = 0; c < kChunk; ++c) {
+      for (int c = 0; c < kLanes; ++c) {
         const double ep = c < left ? eps_k[w + c] : 0.0f;
         const double rx = static_cast<float>(run.rx0 + (w + c));
         // u = u_p + omega x r at the cell centre
@@ -325,15 +353,15 @@ void PartiallySaturatedCells<Real>::exchange_runs(const lattice::CoveredRow<Real
   const lattice::Vector3 body = body_force_;
   // per cell of a chunk of the run: what it adds to the run's sums (rows of
   // Sums' order; four rows of zeros make two whole groups of eight)
-  alignas(64) double q[16][kChunk] = {};
+  alignas(64) double q[16][kLanes] = {};
   for (const Run& run : t.runs) {
     const double y = run.ry, z = run.rz;
     const float* const eps_k = &t.eps[static_cast<std::size_t>(run.first)];
     LaneSums sums;
-    for (int w = 0; w < run.count; w += kChunk) {
+    for (int w = 0; w < run.count; w += kLanes) {
       const int x0 = run.x + w, left = run.count - w;
 #pragma omp simd
-      for (int c = 0; c < kChunk; ++c) {
+      for (int c = 0; c < kLanes; ++c) {
         const int x = x0 + c;
         const bool inside = c < left;  // the cells beyond the run count nothing
         const double ep = inside ? eps_k[w + c] : 0.0f;

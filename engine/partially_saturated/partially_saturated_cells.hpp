@@ -13,11 +13,11 @@
 // spheres then exchange exactly the same momentum.
 //
 // How it enters the step (the lattice knows no sphere: forced_liquid.hpp's
-// SolidCoverage): apply() only bins the spheres by where they lie across the
-// rows (y, z) and hands itself to the lattice for the next step. For each
-// lattice row the step asks cover(): the row's runs of cells that each
-// nearby sphere may cover (the cells whose centres lie within
-// a_g + sqrt(3)/2 of its centre) are found from the bins, their coverage
+// SolidCoverage): apply() only lists each sphere's slices (its z planes) by
+// plane and band of rows and hands itself to the lattice for the next step.
+// For each lattice row the step asks cover(): the row's runs of cells that
+// each sphere may cover (the cells whose centres lie within a_g + sqrt(3)/2
+// of its centre) are found from the slices of its band, their coverage
 // computed and the coverage and solid velocity written into the row's
 // buffers, all in cache; after the row's collision exchange() sums each run's
 // share of the exchange (force, torque, inside momenta) into its sphere's
@@ -95,20 +95,28 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
   lattice::Extent extent_;
   // per sphere: u_p and omega
   std::vector<std::array<double, 6>> motion_;
-  // The spheres binned by their centres' (y, z): bin (b, c) of bins_[0] x
-  // bins_[1] holds binned_[bin_first_[b + bins_[0] c] .. next - 1], in index
-  // order, with the centre (in the box) and the lowest corner of the box of
-  // B^3 cells around it (unwrapped). Bins are at least a_g + sqrt(3)/2 + 1
-  // wide, so the spheres that reach a row lie in its bin or the ones next to
-  // it.
-  struct Binned {
-    std::int32_t sphere;
-    std::int32_t corner[3];
-    double centre[3];
+  // One sphere's slice of its box in one z plane (plane k of the box): the
+  // rows it may reach there are y = corner_y + j, j = j0 .. j1 (wrapped), with
+  // its centre's x and y and the plane's distance rz from the centre.
+  struct Slice {
+    std::int32_t sphere, plane;
+    std::int32_t corner_x, corner_y, j0, j1;
+    double centre_x, centre_y, rz;
   };
-  int bins_[2] = {1, 1};
-  std::vector<std::int32_t> bin_first_;
-  std::vector<Binned> binned_;
+  // The slices by z plane and band of rows (bands_ bands of at least
+  // max(8, a_g + sqrt(3)/2) rows across y): band b of plane z holds
+  // slices_[band_first_[b + bands_ z] .. next - 1], in sphere order, every
+  // slice that reaches a row of the band. A row looks at its band only.
+  int bands_ = 1;
+  std::vector<std::int32_t> band_of_row_, band_first_;
+  std::vector<Slice> slices_;
+  // (apply()'s lists before the slices are placed by band)
+  struct Listed {
+    Slice slice;
+    int z = 0, count = 0, bands[3] = {0, 0, 0};
+  };
+  std::vector<Listed> listed_;
+  std::vector<std::int32_t> next_;
   // sums_[B s + k]: sphere s's, plane k of its box
   std::vector<Sums> sums_;
   lattice::Vector3 body_force_;
