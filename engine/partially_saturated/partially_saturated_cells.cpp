@@ -62,15 +62,13 @@ class LaneSums {
       total_[g] += tree(p[0], p[4], p[2], p[6], p[1], p[5], p[3], p[7]);
     }
   }
-  // Adds the first 12 sums, in order, to those of `out`.
+  // Adds the 16 sums, in order, to those of `out` (16 doubles, 64-byte aligned).
   template <class Sums>
   void add_to(Sums& out) const {
-    static_assert(sizeof(Sums) == 12 * sizeof(double), "twelve sums");
-    double all[16], sum[12];
-    std::memcpy(all, total_, sizeof all);
-    std::memcpy(sum, &out, sizeof sum);
-    for (int i = 0; i < 12; ++i) sum[i] += all[i];
-    std::memcpy(&out, sum, sizeof sum);
+    static_assert(sizeof(Sums) == sizeof total_ && alignof(Sums) >= alignof(V8), "16 sums");
+    V8* const to = reinterpret_cast<V8*>(&out);
+    to[0] += total_[0];
+    to[1] += total_[1];
   }
 
  private:
@@ -159,7 +157,7 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
       const int j1 = std::min(B - 1, static_cast<int>(std::floor(c[1] + half)) - lo[1]);
       if (j0 > j1) continue;
       Listed l;
-      l.slice = {static_cast<std::int32_t>(s), k, lo[0], lo[1], j0, j1, c[0], c[1], rz};
+      l.slice = {static_cast<std::int32_t>(s), 0, lo[0], lo[1], j0, j1, c[0], c[1], rz};
       l.z = wrap_once(lo[2] + k, e.nz);
       // the bands its rows y0 .. y1 meet, each once (the rows wrap into at
       // most two stretches)
@@ -184,6 +182,14 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
       listed_.push_back(l);
     }
   }
+  // Each slice's sums get a slot, plane by plane (in sphere order within a
+  // plane): the thread stepping a plane writes a few KiB of them, together.
+  next_.assign(static_cast<std::size_t>(e.nz) + 1, 0);
+  for (const Listed& l : listed_) ++next_[static_cast<std::size_t>(l.z) + 1];
+  for (int z = 0; z < e.nz; ++z)
+    next_[static_cast<std::size_t>(z) + 1] += next_[static_cast<std::size_t>(z)];
+  for (Listed& l : listed_) l.slice.sums = next_[static_cast<std::size_t>(l.z)]++;
+  sums_.assign(listed_.size(), Sums{});
   for (std::size_t b = 0; b + 1 < band_first_.size(); ++b) band_first_[b + 1] += band_first_[b];
   next_.assign(band_first_.begin(), band_first_.end() - 1);
   slices_.resize(static_cast<std::size_t>(band_first_.back()));
@@ -191,7 +197,6 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
     for (int q = 0; q < l.count; ++q)
       slices_[static_cast<std::size_t>(
           next_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z)]++)] = l.slice;
-  sums_.assign(n * static_cast<std::size_t>(box_), Sums{});
   body_force_ = liquid.body_force();
   liquid.set_solid_coverage(this);
 }
@@ -262,7 +267,7 @@ void PartiallySaturatedCells<Real>::find_runs(int y, int z, Scratch& t) const {
     const std::size_t s = static_cast<std::size_t>(slice.sphere);
     Run run;
     run.sphere = static_cast<std::int32_t>(s);
-    run.sums = static_cast<std::size_t>(B) * s + static_cast<std::size_t>(slice.plane);
+    run.sums = static_cast<std::size_t>(slice.sums);
     run.ry = ry_f;
     run.rz = rz_f;
     for (int i = i0; i <= i1;) {  // pieces that do not cross the edge in x
@@ -395,30 +400,30 @@ void PartiallySaturatedCells<Real>::exchange_runs(const lattice::CoveredRow<Real
 template <class Real>
 void PartiallySaturatedCells<Real>::after_liquid_step(const lattice::ForcedLiquid<Real>& liquid,
                                                       const spheres::SphereSet& spheres) {
-  const std::size_t n = spheres.size(), B = static_cast<std::size_t>(box_);
-  if (sums_.size() != n * B)
+  const std::size_t n = spheres.size();
+  if (motion_.size() != n || sums_.size() != listed_.size())
     throw std::logic_error("partially saturated cells: after_liquid_step() without apply()");
   if (liquid.pending_solid_coverage() == this)
     throw std::logic_error(
         "partially saturated cells: after_liquid_step() before the liquid's step");
-  this->force_.assign(n, Vec3::Zero());
-  this->torque_.assign(n, Vec3::Zero());
-  std::vector<Vec3> momentum(n, Vec3::Zero()), angular(n, Vec3::Zero());
-  // each sphere's planes in order
+  std::vector<Vec3> dP(n, Vec3::Zero()), r_dP(n, Vec3::Zero()), momentum(n, Vec3::Zero()),
+      angular(n, Vec3::Zero());
+  // each sphere's slices, in the order of its planes (listed_ is in sphere
+  // order, then plane order)
+  for (const Listed& l : listed_) {
+    const Sums& m = sums_[static_cast<std::size_t>(l.slice.sums)];
+    const std::size_t s = static_cast<std::size_t>(l.slice.sphere);
+    dP[s] += Vec3(m.dP[0], m.dP[1], m.dP[2]);
+    r_dP[s] += Vec3(m.r_dP[0], m.r_dP[1], m.r_dP[2]);
+    momentum[s] += Vec3(m.P[0], m.P[1], m.P[2]);
+    angular[s] += Vec3(m.r_P[0], m.r_P[1], m.r_P[2]);
+  }
+  // the spheres give up what their solid operator gave the liquid
+  this->force_.resize(n);
+  this->torque_.resize(n);
   for (std::size_t s = 0; s < n; ++s) {
-    Vec3 dP = Vec3::Zero(), r_dP = Vec3::Zero(), P = Vec3::Zero(), r_P = Vec3::Zero();
-    for (std::size_t k = 0; k < B; ++k) {
-      const Sums& m = sums_[B * s + k];
-      dP += Vec3(m.dP[0], m.dP[1], m.dP[2]);
-      r_dP += Vec3(m.r_dP[0], m.r_dP[1], m.r_dP[2]);
-      P += Vec3(m.P[0], m.P[1], m.P[2]);
-      r_P += Vec3(m.r_P[0], m.r_P[1], m.r_P[2]);
-    }
-    // the spheres give up what their solid operator gave the liquid
-    this->force_[s] = -dP;
-    this->torque_[s] = -r_dP;
-    momentum[s] = P;
-    angular[s] = r_P;
+    this->force_[s] = -dP[s];
+    this->torque_[s] = -r_dP[s];
   }
   this->record_internal_momenta(std::move(momentum), std::move(angular));
 }

@@ -81,8 +81,9 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
   // What the step measured for one sphere in one plane of its box: the
   // momentum the sphere's share of the solid operator gave the liquid (dP),
   // r x dP, eps_k rho u and r x eps_k rho u, summed over its cells there.
-  struct Sums {
-    double dP[3], r_dP[3], P[3], r_P[3];
+  // (Four zeros fill it to one aligned vector store of 16 lanes.)
+  struct alignas(64) Sums {
+    double dP[3], r_dP[3], P[3], r_P[3], zero[4];
   };
 
   // Finds the runs of row (y, z) into `t` and their cells' coverage.
@@ -95,11 +96,11 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
   lattice::Extent extent_;
   // per sphere: u_p and omega
   std::vector<std::array<double, 6>> motion_;
-  // One sphere's slice of its box in one z plane (plane k of the box): the
-  // rows it may reach there are y = corner_y + j, j = j0 .. j1 (wrapped), with
-  // its centre's x and y and the plane's distance rz from the centre.
+  // One sphere's slice of its box in one z plane: the rows it may reach
+  // there are y = corner_y + j, j = j0 .. j1 (wrapped), with its centre's x
+  // and y and the plane's distance rz from the centre.
   struct Slice {
-    std::int32_t sphere, plane;
+    std::int32_t sphere, sums;  // sums: its slot in sums_
     std::int32_t corner_x, corner_y, j0, j1;
     double centre_x, centre_y, rz;
   };
@@ -110,14 +111,16 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
   int bands_ = 1;
   std::vector<std::int32_t> band_of_row_, band_first_;
   std::vector<Slice> slices_;
-  // (apply()'s lists before the slices are placed by band)
+  // Every slice with its plane and the bands it meets, in sphere order, then
+  // plane order (apply() places them by band; after_liquid_step() adds each
+  // sphere's sums up in this order).
   struct Listed {
     Slice slice;
     int z = 0, count = 0, bands[3] = {0, 0, 0};
   };
   std::vector<Listed> listed_;
   std::vector<std::int32_t> next_;
-  // sums_[B s + k]: sphere s's, plane k of its box
+  // The sums of every slice of every sphere, by plane (Slice::sums).
   std::vector<Sums> sums_;
   lattice::Vector3 body_force_;
   std::vector<Scratch> scratch_;  // per thread
