@@ -361,7 +361,7 @@ template <class Real>
 class CoveredRowBuffers {
  public:
   explicit CoveredRowBuffers(int nx) {
-    constexpr int C = CoveredRow<Real>::kChunk;
+    constexpr int C = kChunk;
     const std::size_t cells = static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad;
     values_.assign(8 * cells, Real(0));
     chunks_.assign(static_cast<std::size_t>((nx + C - 1) / C + 63) / 64, 0);
@@ -378,7 +378,7 @@ class CoveredRowBuffers {
   CoveredRow<Real>& row() { return row_; }
   // Back to zero coverage and no marked chunk, after the row is done.
   void reset() {
-    constexpr int C = CoveredRow<Real>::kChunk;
+    constexpr int C = kChunk;
     for (std::size_t w = 0; w < chunks_.size(); ++w) {
       for (std::uint64_t bits = chunks_[w]; bits != 0; bits &= bits - 1) {
         const int x0 = C * (64 * static_cast<int>(w) + __builtin_ctzll(bits));
@@ -518,7 +518,7 @@ void FluidLattice<Real>::step_kernel() {
         covered_row = solid->cover(cover);
       }
       const auto chunk_covered = [&](int x) {
-        constexpr int C = CoveredRow<Real>::kChunk;
+        constexpr int C = kChunk;
         return covered_row && (cover.chunks[x / C / 64] >> (x / C % 64) & 1);
       };
 
@@ -529,7 +529,7 @@ void FluidLattice<Real>::step_kernel() {
       if (covered_row) {
         // span by span: the covered chunks take the blended collision, the
         // stretches between them the plain one
-        constexpr int C = CoveredRow<Real>::kChunk;
+        constexpr int C = kChunk;
         for (int x0 = x_begin; x0 < x_end;) {
           const bool covered = chunk_covered(x0);
           int x1 = std::min(x_end, (x0 / C + 1) * C);

@@ -36,6 +36,12 @@ struct ForceFieldView {
   Real* row(int d, long r) const { return component[d] + static_cast<long>(extent.nx) * r; }
 };
 
+// Couplings mark lattice rows for their attention (the immersed boundary's
+// cells to read, the partially saturated cells' covered cells) in chunks of
+// kChunk cells, x = kChunk c .. kChunk c + kChunk - 1: one vector of floats,
+// so that a marked stretch is swept in whole vectors.
+inline constexpr int kChunk = 16;
+
 // Partially saturated cells (Noble & Torczynski 1998; the collision itself in
 // partially_saturated_collision.hpp) enter the step row by row. The lattice
 // knows nothing of spheres: it lends each row a CoveredRow of row-local
@@ -48,13 +54,11 @@ struct ForceFieldView {
 // Per cell x of the row (x fastest within the lattice, row r = y + ny z):
 // eps = sum_k eps_k, the summed coverage of the spheres k overlapping the
 // cell, and V = sum_k eps_k u_k, the coverage-weighted solid velocity (u_k the
-// velocity of sphere k's surface motion at the cell centre). Chunks are 16
-// cells of the row (x = 16 c .. 16 c + 15); the blended collision runs on the
-// marked chunks (on their uncovered cells too, with eps = 0), the plain one
-// elsewhere.
+// velocity of sphere k's surface motion at the cell centre). The blended
+// collision runs on the marked chunks (kChunk cells each; on their uncovered
+// cells too, with eps = 0), the plain one elsewhere.
 template <class Real>
 struct CoveredRow {
-  static constexpr int kChunk = 16;
   // Every per-cell array holds nx + kPad values (x = nx .. nx + kPad - 1 are
   // slack for vector loops over whole chunks; they stay zero where zero).
   static constexpr int kPad = 16;

@@ -134,7 +134,7 @@ class UniformCoverage final : public lattice::SolidCoverage<Real> {
   void begin_step(int) override {}
   bool cover(lattice::CoveredRow<Real>& row) override {
     for (int x = 0; x < row.nx; ++x) {
-      const int c = x / lattice::CoveredRow<Real>::kChunk;
+      const int c = x / lattice::kChunk;
       row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
       row.coverage[x] = static_cast<Real>(eps_);
       for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = static_cast<Real>(eps_ * velocity[d]);

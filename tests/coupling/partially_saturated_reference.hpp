@@ -33,7 +33,7 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   void apply(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& s) {
     const lattice::Extent e = liquid.extent();
     const std::size_t cells = static_cast<std::size_t>(e.cells());
-    chunk_words_ = (e.nx + kChunk - 1) / kChunk / 64 + 1;
+    chunk_words_ = (e.nx + lattice::kChunk - 1) / lattice::kChunk / 64 + 1;
     nx_ = e.nx;
     coverage_.assign(cells, Real(0));
     for (auto& v : solid_velocity_) v.assign(cells, Real(0));
@@ -69,7 +69,8 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
             q.eps = std::abs(rxd) <= half_in ? 1.0f : shape(q.r[0], q.r[1], q.r[2]);
             cells_[k].push_back(q);
             const int x = static_cast<int>(q.index % static_cast<std::size_t>(e.nx));
-            chunks_[r * chunk_words_ + x / kChunk / 64] |= std::uint64_t(1) << (x / kChunk % 64);
+            chunks_[r * chunk_words_ + x / lattice::kChunk / 64] |= std::uint64_t(1)
+                                                                    << (x / lattice::kChunk % 64);
           }
         }
       const spheres::Vec3 up = s.velocity[k], w = s.angular_velocity[k];
@@ -132,14 +133,13 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   void exchange(const lattice::CoveredRow<Real>& row) override {
     const std::size_t at = static_cast<std::size_t>(row.row) * nx_;
     for (int x = 0; x < nx_; ++x) {
-      if (!(row.chunks[x / kChunk / 64] >> (x / kChunk % 64) & 1)) continue;
+      if (!(row.chunks[x / lattice::kChunk / 64] >> (x / lattice::kChunk % 64) & 1)) continue;
       density_[at + x] = row.density[x];
       for (int d = 0; d < 3; ++d) momentum_[d][at + x] = row.momentum[d][x];
     }
   }
 
  private:
-  static constexpr int kChunk = lattice::CoveredRow<Real>::kChunk;
   static constexpr double kHalfDiagonal = 0.8660254037844386;
   struct Cell {
     std::size_t index;
