@@ -43,7 +43,7 @@ std::vector<std::vector<std::vector<int>>> make_colours(
 
 void ChunkMask::mark(long r, int x, int count) {
   std::uint64_t* word = row(static_cast<std::size_t>(r));
-  for (int c = x / lattice::kChunk; c <= (x + count - 1) / lattice::kChunk; ++c)
+  for (int c = x / kChunk; c <= (x + count - 1) / kChunk; ++c)
     std::atomic_ref<std::uint64_t>(word[c / 64])
         .fetch_or(std::uint64_t(1) << (c % 64), std::memory_order_relaxed);
 }

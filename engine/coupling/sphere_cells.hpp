@@ -52,13 +52,15 @@ void for_each_box_run(const std::array<int, 3>& lo, const std::int16_t* rows, in
 std::vector<std::vector<std::vector<int>>> make_colours(
     const std::vector<std::array<int, 3>>& origins, int box, const lattice::Extent& extent);
 
-// One bit per chunk of every lattice row (lattice::kChunk cells): which
-// chunks hold cells of interest (the cells some sphere reads, or holds a
-// force on).
+// One bit per chunk of kChunk cells of every lattice row: which chunks hold
+// cells of interest (the cells some sphere reads, or holds a force on).
+// Chunk c of row r covers x = kChunk c .. kChunk c + kChunk - 1: one vector of
+// floats, so that a marked stretch is swept in whole vectors.
 class ChunkMask {
  public:
+  static constexpr int kChunk = 16;
   void resize(const lattice::Extent& e) {
-    chunks_ = (e.nx + lattice::kChunk - 1) / lattice::kChunk;
+    chunks_ = (e.nx + kChunk - 1) / kChunk;
     words_ = (chunks_ + 63) / 64;
     const std::size_t size = static_cast<std::size_t>(e.rows()) * words_;
     if (bits_.size() != size) bits_.assign(size, 0);

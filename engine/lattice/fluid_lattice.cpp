@@ -360,13 +360,11 @@ namespace {
 template <class Real>
 class CoveredRowBuffers {
  public:
-  explicit CoveredRowBuffers(int nx) {
-    constexpr int C = kChunk;
-    const std::size_t cells = static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad;
+  explicit CoveredRowBuffers(int nx)
+      : cells_(static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad) {
+    const std::size_t cells = cells_;
     values_.assign(8 * cells, Real(0));
-    chunks_.assign(static_cast<std::size_t>((nx + C - 1) / C + 63) / 64, 0);
     row_.nx = nx;
-    row_.chunks = chunks_.data();
     Real* p = values_.data();
     row_.coverage = p;
     row_.density = p + 4 * cells;
@@ -376,22 +374,12 @@ class CoveredRowBuffers {
     }
   }
   CoveredRow<Real>& row() { return row_; }
-  // Back to zero coverage and no marked chunk, after the row is done.
-  void reset() {
-    constexpr int C = kChunk;
-    for (std::size_t w = 0; w < chunks_.size(); ++w) {
-      for (std::uint64_t bits = chunks_[w]; bits != 0; bits &= bits - 1) {
-        const int x0 = C * (64 * static_cast<int>(w) + __builtin_ctzll(bits));
-        std::fill_n(row_.coverage + x0, C, Real(0));
-        for (int d = 0; d < 3; ++d) std::fill_n(row_.solid_velocity[d] + x0, C, Real(0));
-      }
-      chunks_[w] = 0;
-    }
-  }
+  // Back to zero coverage after a covered row (eps and V lie first, together).
+  void reset() { std::fill_n(values_.data(), 4 * cells_, Real(0)); }
 
  private:
+  std::size_t cells_ = 0;
   std::vector<Real> values_;
-  std::vector<std::uint64_t> chunks_;
   CoveredRow<Real> row_;
 };
 
@@ -517,32 +505,15 @@ void FluidLattice<Real>::step_kernel() {
         }
         covered_row = solid->cover(cover);
       }
-      const auto chunk_covered = [&](int x) {
-        constexpr int C = kChunk;
-        return covered_row && (cover.chunks[x / C / 64] >> (x / C % 64) & 1);
-      };
-
       // Interior of the row: every shifted pointer stays inside the row, so
       // the loop is a plain unit-stride sweep the compiler vectorises.
       const int x_begin = even ? 0 : 1;
       const int x_end = even ? nx : nx - 1;
       if (covered_row) {
-        // span by span: the covered chunks take the blended collision, the
-        // stretches between them the plain one
-        constexpr int C = kChunk;
-        for (int x0 = x_begin; x0 < x_end;) {
-          const bool covered = chunk_covered(x0);
-          int x1 = std::min(x_end, (x0 / C + 1) * C);
-          while (x1 < x_end && chunk_covered(x1) == covered) x1 = std::min(x_end, x1 + C);
-          if (covered) {
+        // the whole row blended, its uncovered cells with eps = 0
+        // (forced_liquid.hpp: CoveredRow says why)
 #pragma omp simd
-            for (int x = x0; x < x1; ++x) update_covered(x, load, store, x, x);
-          } else {
-#pragma omp simd
-            for (int x = x0; x < x1; ++x) update(x, load, store, x, x);
-          }
-          x0 = x1;
-        }
+        for (int x = x_begin; x < x_end; ++x) update_covered(x, load, store, x, x);
       } else {
 #pragma omp simd
         for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
@@ -561,7 +532,7 @@ void FluidLattice<Real>::step_kernel() {
             ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
             st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
           }
-          if (chunk_covered(x))
+          if (covered_row)
             update_covered(x, ld, st, 0, 0);
           else
             update(x, ld, st, 0, 0);

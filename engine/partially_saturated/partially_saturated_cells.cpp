@@ -308,9 +308,6 @@ bool PartiallySaturatedCells<Real>::cover(lattice::CoveredRow<Real>& row) {
   Real* const V1 = row.solid_velocity[1];
   Real* const V2 = row.solid_velocity[2];
   for (const Run& run : t.runs) {
-    constexpr int C = lattice::kChunk;
-    for (int c = run.x / C; c <= (run.x + run.count - 1) / C; ++c)
-      row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
     const std::array<double, 6>& m = motion_[static_cast<std::size_t>(run.sphere)];
     const float* const eps_k = &t.eps[static_cast<std::size_t>(run.first)];
     // whole chunks of the run at a time (the row's buffers have the slack):

@@ -118,7 +118,7 @@ TEST(CellCoverage, BranchFreeFormAndSmallMovesAgree) {
 }
 
 // Covers every cell of a lattice alike (coverage eps, solid velocity u_s,
-// every chunk marked) and keeps the density and momentum each cell's
+// every row covered) and keeps the density and momentum each cell's
 // collision saw, in lattice order.
 template <class Real>
 class UniformCoverage final : public lattice::SolidCoverage<Real> {
@@ -134,8 +134,6 @@ class UniformCoverage final : public lattice::SolidCoverage<Real> {
   void begin_step(int) override {}
   bool cover(lattice::CoveredRow<Real>& row) override {
     for (int x = 0; x < row.nx; ++x) {
-      const int c = x / lattice::kChunk;
-      row.chunks[c / 64] |= std::uint64_t(1) << (c % 64);
       row.coverage[x] = static_cast<Real>(eps_);
       for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = static_cast<Real>(eps_ * velocity[d]);
     }
@@ -215,9 +213,9 @@ TEST(PartiallySaturatedCollision, FullyCoveredCellsTakeTheSolidVelocity) {
   }
 }
 
-// A chunk marked covered whose cells hold no solid collides exactly as the
-// plain liquid (to round-off: the blend is evaluated with B = 0).
-TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredChunkAreLiquid) {
+// Cells of a covered row that hold no solid collide exactly as the plain
+// liquid (to round-off: the blend is evaluated with B = 0).
+TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredRowAreLiquid) {
   const lattice::Extent e{20, 3, 3};
   auto init = [](int x, int y, int z) {
     return lattice::Macroscopic{1.0 + 0.01 * std::cos(x + y - z),
@@ -228,7 +226,7 @@ TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredChunkAreLiquid) {
     f->set_body_force({1e-5, 0, 0});
     f->initialise_equilibrium(init);
   }
-  UniformCoverage<double> cover(e, 0.0, {0, 0, 0});  // marks every chunk of every row
+  UniformCoverage<double> cover(e, 0.0, {0, 0, 0});  // covers every row, with eps = 0
   for (int s = 0; s < 7; ++s) {                      // odd and even steps
     plain.step();
     blended.set_solid_coverage(&cover);

@@ -4,7 +4,7 @@
 // reproduce to round-off: per sphere, a list of its cells with their
 // coverage; the coverage and the coverage-weighted solid velocity added into
 // lattice-sized arrays before the step; the density and momentum each
-// covered chunk's collision saw copied out into lattice-sized arrays; after
+// covered row's collision saw copied out into lattice-sized arrays; after
 // the step each sphere's loads gathered from those arrays cell by cell. Only
 // the arrays moved out of the lattice (which no longer has them) into this
 // class, which hands them to the step row by row; nothing is fused, nothing
@@ -33,13 +33,12 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   void apply(lattice::ForcedLiquid<Real>& liquid, const spheres::SphereSet& s) {
     const lattice::Extent e = liquid.extent();
     const std::size_t cells = static_cast<std::size_t>(e.cells());
-    chunk_words_ = (e.nx + lattice::kChunk - 1) / lattice::kChunk / 64 + 1;
     nx_ = e.nx;
     coverage_.assign(cells, Real(0));
     for (auto& v : solid_velocity_) v.assign(cells, Real(0));
     density_.assign(cells, Real(0));
     for (auto& v : momentum_) v.assign(cells, Real(0));
-    chunks_.assign(static_cast<std::size_t>(e.rows()) * chunk_words_, 0);
+    row_covered_.assign(static_cast<std::size_t>(e.rows()), 0);
     cells_.assign(s.size(), {});
     const double reach = a_ + kHalfDiagonal, inner = a_ - kHalfDiagonal;
     const partially_saturated::SphereCoverage shape(a_);
@@ -68,9 +67,7 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
             // cells wholly inside skip the cut
             q.eps = std::abs(rxd) <= half_in ? 1.0f : shape(q.r[0], q.r[1], q.r[2]);
             cells_[k].push_back(q);
-            const int x = static_cast<int>(q.index % static_cast<std::size_t>(e.nx));
-            chunks_[r * chunk_words_ + x / lattice::kChunk / 64] |= std::uint64_t(1)
-                                                                    << (x / lattice::kChunk % 64);
+            row_covered_[static_cast<std::size_t>(r)] = 1;
           }
         }
       const spheres::Vec3 up = s.velocity[k], w = s.angular_velocity[k];
@@ -117,12 +114,7 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   // lattice::SolidCoverage: the rows' slices of the arrays
   void begin_step(int) override {}
   bool cover(lattice::CoveredRow<Real>& row) override {
-    bool any = false;
-    for (int w = 0; w < chunk_words_; ++w) {
-      row.chunks[w] = chunks_[row.row * chunk_words_ + w];
-      any = any || row.chunks[w] != 0;
-    }
-    if (!any) return false;
+    if (!row_covered_[static_cast<std::size_t>(row.row)]) return false;
     const std::size_t at = static_cast<std::size_t>(row.row) * nx_;
     for (int x = 0; x < nx_; ++x) {
       row.coverage[x] = coverage_[at + x];
@@ -133,7 +125,6 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
   void exchange(const lattice::CoveredRow<Real>& row) override {
     const std::size_t at = static_cast<std::size_t>(row.row) * nx_;
     for (int x = 0; x < nx_; ++x) {
-      if (!(row.chunks[x / lattice::kChunk / 64] >> (x / lattice::kChunk % 64) & 1)) continue;
       density_[at + x] = row.density[x];
       for (int d = 0; d < 3; ++d) momentum_[d][at + x] = row.momentum[d][x];
     }
@@ -147,12 +138,12 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
     float eps;
   };
   double a_;
-  int nx_ = 0, chunk_words_ = 0;
+  int nx_ = 0;
   lattice::Vector3 body_;
   std::vector<std::vector<Cell>> cells_;
   std::vector<Real> coverage_, density_;
   std::array<std::vector<Real>, 3> solid_velocity_, momentum_;
-  std::vector<std::uint64_t> chunks_;
+  std::vector<char> row_covered_;  // per lattice row: some sphere's cells lie in it
 };
 
 }  // namespace flocsim::testing_support
