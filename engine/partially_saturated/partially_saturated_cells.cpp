@@ -220,8 +220,8 @@ void PartiallySaturatedCells<Real>::find_runs(int y, int z, Scratch& t) const {
   t.runs.clear();
   std::int32_t first = 0;  // in t.eps
   int cuts = 0;            // cells packed for the plane cut
-  const std::size_t band = static_cast<std::size_t>(static_cast<long>(y) * bands_ / e.ny +
-                                                    static_cast<long>(bands_) * z);
+  const std::size_t band =
+      static_cast<std::size_t>(band_of_row_[static_cast<std::size_t>(y)] + bands_ * z);
   for (std::int32_t q = band_first_[band]; q < band_first_[band + 1]; ++q) {
     const Slice& slice = slices_[static_cast<std::size_t>(q)];
     // row y is row j of the sphere's box; the cells of it within
