@@ -135,14 +135,11 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
   for (int y = 0; y < e.ny; ++y)
     band_of_row_[static_cast<std::size_t>(y)] =
         static_cast<std::int32_t>(static_cast<long>(y) * bands_ / e.ny);
-  // Each sphere's slices with the bands they meet (sphere s's m-th slice in
-  // listed_[B s + m]), the spheres shared among the threads.
-  listed_.resize(n * static_cast<std::size_t>(B));
-  slice_count_.assign(n, 0);
-  bool too_many_bands = false;
-#pragma omp parallel for schedule(static) reduction(|| : too_many_bands)
-  for (long sl = 0; sl < static_cast<long>(n); ++sl) {
-    const std::size_t s = static_cast<std::size_t>(sl);
+  // Each sphere's slices with the bands they meet, counted per band; then
+  // placed band by band (in sphere order within a band).
+  band_first_.assign(static_cast<std::size_t>(bands_) * e.nz + 1, 0);
+  listed_.clear();
+  for (std::size_t s = 0; s < n; ++s) {
     // the centre in the box, its box's lowest corner from there (unwrapped)
     double c[3];
     int lo[3];
@@ -151,7 +148,6 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
       c[d] = spheres.position[s][d] - L * std::floor(spheres.position[s][d] / L);
       lo[d] = static_cast<int>(std::floor(c[d] - reach)) - 1;
     }
-    int m = 0;
     for (int k = 0; k < B; ++k) {
       const double rz = lo[2] + k - c[2];
       const double left = reach * reach - rz * rz;
@@ -170,10 +166,8 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
         for (int b = band_of_row_[static_cast<std::size_t>(from)];
              b <= band_of_row_[static_cast<std::size_t>(to)]; ++b) {
           if (std::find(l.bands, l.bands + l.count, b) != l.bands + l.count) continue;
-          if (l.count == 3) {
-            too_many_bands = true;
-            return;
-          }
+          if (l.count == 3)
+            throw std::logic_error("partially saturated cells: a slice meets more than 3 bands");
           l.bands[l.count++] = b;
         }
       };
@@ -183,43 +177,26 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
         add_bands(y0, e.ny - 1);
         add_bands(0, y1);
       }
-      listed_[static_cast<std::size_t>(B) * s + static_cast<std::size_t>(m++)] = l;
+      for (int q = 0; q < l.count; ++q)
+        ++band_first_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z) + 1];
+      listed_.push_back(l);
     }
-    slice_count_[s] = m;
   }
-  if (too_many_bands)
-    throw std::logic_error("partially saturated cells: a slice meets more than 3 bands");
-  // Count the slices per band and per plane. Each slice's sums get a slot,
-  // plane by plane (in sphere order within a plane): the thread stepping a
-  // plane writes a few KiB of them, together.
-  band_first_.assign(static_cast<std::size_t>(bands_) * e.nz + 1, 0);
+  // Each slice's sums get a slot, plane by plane (in sphere order within a
+  // plane): the thread stepping a plane writes a few KiB of them, together.
   next_.assign(static_cast<std::size_t>(e.nz) + 1, 0);
-  const auto for_each_listed = [&](auto&& f) {
-    for (std::size_t s = 0; s < n; ++s)
-      for (int m = 0; m < slice_count_[s]; ++m)
-        f(listed_[static_cast<std::size_t>(B) * s + static_cast<std::size_t>(m)]);
-  };
-  for_each_listed([&](const Listed& l) {
-    ++next_[static_cast<std::size_t>(l.z) + 1];
-    for (int q = 0; q < l.count; ++q)
-      ++band_first_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z) + 1];
-  });
+  for (const Listed& l : listed_) ++next_[static_cast<std::size_t>(l.z) + 1];
   for (int z = 0; z < e.nz; ++z)
     next_[static_cast<std::size_t>(z) + 1] += next_[static_cast<std::size_t>(z)];
-  const long slots = next_[static_cast<std::size_t>(e.nz)];
-  for_each_listed([&](Listed& l) { l.slice.sums = next_[static_cast<std::size_t>(l.z)]++; });
-  sums_.resize(static_cast<std::size_t>(slots));
-#pragma omp parallel for schedule(static)
-  for (long q = 0; q < slots; ++q) sums_[static_cast<std::size_t>(q)] = Sums{};
-  // Then place them band by band (in sphere order within a band).
+  for (Listed& l : listed_) l.slice.sums = next_[static_cast<std::size_t>(l.z)]++;
+  sums_.assign(listed_.size(), Sums{});
   for (std::size_t b = 0; b + 1 < band_first_.size(); ++b) band_first_[b + 1] += band_first_[b];
   next_.assign(band_first_.begin(), band_first_.end() - 1);
   slices_.resize(static_cast<std::size_t>(band_first_.back()));
-  for_each_listed([&](const Listed& l) {
+  for (const Listed& l : listed_)
     for (int q = 0; q < l.count; ++q)
       slices_[static_cast<std::size_t>(
           next_[static_cast<std::size_t>(l.bands[q] + bands_ * l.z)]++)] = l.slice;
-  });
   body_force_ = liquid.body_force();
   liquid.set_solid_coverage(this);
 }
@@ -427,33 +404,29 @@ template <class Real>
 void PartiallySaturatedCells<Real>::after_liquid_step(const lattice::ForcedLiquid<Real>& liquid,
                                                       const spheres::SphereSet& spheres) {
   const std::size_t n = spheres.size();
-  if (motion_.size() != n || slice_count_.size() != n)
+  if (motion_.size() != n || sums_.size() != listed_.size())
     throw std::logic_error("partially saturated cells: after_liquid_step() without apply()");
   if (liquid.pending_solid_coverage() == this)
     throw std::logic_error(
         "partially saturated cells: after_liquid_step() before the liquid's step");
+  std::vector<Vec3> dP(n, Vec3::Zero()), r_dP(n, Vec3::Zero()), momentum(n, Vec3::Zero()),
+      angular(n, Vec3::Zero());
+  // each sphere's slices, in the order of its planes (listed_ is in sphere
+  // order, then plane order)
+  for (const Listed& l : listed_) {
+    const Sums& m = sums_[static_cast<std::size_t>(l.slice.sums)];
+    const std::size_t s = static_cast<std::size_t>(l.slice.sphere);
+    dP[s] += Vec3(m.dP[0], m.dP[1], m.dP[2]);
+    r_dP[s] += Vec3(m.r_dP[0], m.r_dP[1], m.r_dP[2]);
+    momentum[s] += Vec3(m.P[0], m.P[1], m.P[2]);
+    angular[s] += Vec3(m.r_P[0], m.r_P[1], m.r_P[2]);
+  }
+  // the spheres give up what their solid operator gave the liquid
   this->force_.resize(n);
   this->torque_.resize(n);
-  std::vector<Vec3> momentum(n), angular(n);
-  const std::size_t B = static_cast<std::size_t>(box_);
-  // each sphere's slices, in the order of its planes
-#pragma omp parallel for schedule(static)
-  for (long sl = 0; sl < static_cast<long>(n); ++sl) {
-    const std::size_t s = static_cast<std::size_t>(sl);
-    Vec3 dP = Vec3::Zero(), r_dP = Vec3::Zero(), P = Vec3::Zero(), r_P = Vec3::Zero();
-    for (int m = 0; m < slice_count_[s]; ++m) {
-      const Listed& l = listed_[B * s + static_cast<std::size_t>(m)];
-      const Sums& q = sums_[static_cast<std::size_t>(l.slice.sums)];
-      dP += Vec3(q.dP[0], q.dP[1], q.dP[2]);
-      r_dP += Vec3(q.r_dP[0], q.r_dP[1], q.r_dP[2]);
-      P += Vec3(q.P[0], q.P[1], q.P[2]);
-      r_P += Vec3(q.r_P[0], q.r_P[1], q.r_P[2]);
-    }
-    // the spheres give up what their solid operator gave the liquid
-    this->force_[s] = -dP;
-    this->torque_[s] = -r_dP;
-    momentum[s] = P;
-    angular[s] = r_P;
+  for (std::size_t s = 0; s < n; ++s) {
+    this->force_[s] = -dP[s];
+    this->torque_[s] = -r_dP[s];
   }
   this->record_internal_momenta(std::move(momentum), std::move(angular));
 }

@@ -111,15 +111,14 @@ class PartiallySaturatedCells final : public coupling::SphereCoupling<Real>,
   int bands_ = 1;
   std::vector<std::int32_t> band_of_row_, band_first_;
   std::vector<Slice> slices_;
-  // Every slice with its plane and the bands it meets: sphere s's, in plane
-  // order, are listed_[B s .. B s + slice_count_[s] - 1] (apply() places them
-  // by band; after_liquid_step() adds each sphere's sums up in this order).
+  // Every slice with its plane and the bands it meets, in sphere order, then
+  // plane order (apply() places them by band; after_liquid_step() adds each
+  // sphere's sums up in this order).
   struct Listed {
     Slice slice;
     int z = 0, count = 0, bands[3] = {0, 0, 0};
   };
   std::vector<Listed> listed_;
-  std::vector<int> slice_count_;
   std::vector<std::int32_t> next_;
   // The sums of every slice of every sphere, by plane (Slice::sums).
   std::vector<Sums> sums_;
