@@ -356,13 +356,13 @@ void FluidLattice<Real>::step() {
 namespace {
 
 // The buffers one thread lends the partially saturated cells for each row it
-// steps (forced_liquid.hpp: CoveredRow), zero at first; the coverage sets its
-// cells back to zero after each row.
+// steps (forced_liquid.hpp: CoveredRow), zero where the row format wants zero.
 template <class Real>
 class CoveredRowBuffers {
  public:
-  explicit CoveredRowBuffers(int nx) {
-    const std::size_t cells = static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad;
+  explicit CoveredRowBuffers(int nx)
+      : cells_(static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad) {
+    const std::size_t cells = cells_;
     values_.assign(8 * cells, Real(0));
     row_.nx = nx;
     Real* p = values_.data();
@@ -374,8 +374,11 @@ class CoveredRowBuffers {
     }
   }
   CoveredRow<Real>& row() { return row_; }
+  // Back to zero coverage after a covered row (eps and V lie first, together).
+  void reset() { std::fill_n(values_.data(), 4 * cells_, Real(0)); }
 
  private:
+  std::size_t cells_ = 0;
   std::vector<Real> values_;
   CoveredRow<Real> row_;
 };
@@ -539,6 +542,7 @@ void FluidLattice<Real>::step_kernel() {
       if constexpr (kCoverage)
         if (covered_row) {
           solid->exchange(cover);
+          buffers.reset();
         }
     };
 

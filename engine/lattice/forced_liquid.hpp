@@ -62,9 +62,7 @@ struct CoveredRow {
   long row = 0;
   int y = 0, z = 0, nx = 0;
   int thread = 0;  // the stepping thread: 0 .. threads - 1 (SolidCoverage::begin_step)
-  // Written by the SolidCoverage's cover(), zero on entry; its exchange()
-  // sets them back to zero (clearing only the cells it wrote costs a third
-  // of clearing the row, which took 5 % of an idle machine's step):
+  // Written by the SolidCoverage (they are zero on entry):
   Real* coverage = nullptr;                               // eps
   Real* solid_velocity[3] = {nullptr, nullptr, nullptr};  // V
   // Written by the collision on every cell of a covered row: the density
@@ -93,8 +91,7 @@ class SolidCoverage {
   // False when no cell of the row is covered (then nothing was written).
   virtual bool cover(CoveredRow<Real>& row) = 0;
   // After the row's collision: its density and momentum, to measure the
-  // momentum exchanged there; then eps and V back to zero where cover()
-  // wrote them.
+  // momentum exchanged there.
   virtual void exchange(const CoveredRow<Real>& row) = 0;
 };
 

@@ -335,12 +335,6 @@ void PartiallySaturatedCells<Real>::exchange(const lattice::CoveredRow<Real>& ro
     exchange_runs<true>(row);
   else
     exchange_runs<false>(row);
-  // the row's coverage back to zero for the next row (forced_liquid.hpp)
-  const Scratch& t = scratch_[static_cast<std::size_t>(row.thread)];
-  for (const Run& run : t.runs) {
-    std::fill_n(row.coverage + run.x, run.count, Real(0));
-    for (int d = 0; d < 3; ++d) std::fill_n(row.solid_velocity[d] + run.x, run.count, Real(0));
-  }
 }
 
 template <class Real>

@@ -144,8 +144,6 @@ class UniformCoverage final : public lattice::SolidCoverage<Real> {
     for (int x = 0; x < row.nx; ++x) {
       density[at + x] = row.density[x];
       for (int d = 0; d < 3; ++d) momentum[d][at + x] = row.momentum[d][x];
-      row.coverage[x] = 0;
-      for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = 0;
     }
   }
 

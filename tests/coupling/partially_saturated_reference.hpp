@@ -127,8 +127,6 @@ class ReferencePartiallySaturatedCells final : public lattice::SolidCoverage<Rea
     for (int x = 0; x < nx_; ++x) {
       density_[at + x] = row.density[x];
       for (int d = 0; d < 3; ++d) momentum_[d][at + x] = row.momentum[d][x];
-      row.coverage[x] = 0;
-      for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = 0;
     }
   }
 
