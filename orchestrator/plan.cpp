@@ -83,9 +83,17 @@ std::string describe(const run::CaseSize& z, const json& key) {
   if (z.spheres > 0) d += ", " + std::to_string(z.spheres) + " spheres";
   d += z.single_precision ? ", float" : ", double";
   const auto ib = get_path(key, "numerics.immersed_boundary");
-  if (ib && ib->is_object())
-    d += ", IB markers " + get_path(*ib, "marker_spacing").value_or(json()).dump() + " dx, " +
-         get_path(*ib, "sweeps").value_or(json()).dump() + " sweep(s)";
+  const auto coupling = get_path(key, "numerics.coupling");
+  auto text = [](const std::optional<json>& v) { return v.value_or(json()).dump(); };
+  if (ib && ib->is_object()) {
+    d += ", IB markers " + text(get_path(*ib, "marker_spacing")) + " dx, ";
+    if (get_path(*ib, "forcing").value_or(json()) == "control")
+      d += "control forcing";
+    else
+      d += text(get_path(*ib, "sweeps")) + " sweep(s)";
+  } else if (coupling && coupling->is_string()) {
+    d += ", " + coupling->get<std::string>();
+  }
   return d;
 }
 

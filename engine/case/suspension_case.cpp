@@ -72,6 +72,13 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
   scheme.kernel = *coupling::kernel_from_name(
       ib.choice("kernel", coupling::kernel_names(), coupling::kernel_name(defaults.kernel)));
   if (scheme.control()) {
+    if (scheme.marker_spacing < coupling::kSmallestControlMarkerSpacing)
+      throw InputError(
+          "numerics.immersed_boundary.marker_spacing = " + format_value(scheme.marker_spacing) +
+          " with control forcing: must be >= " +
+          format_value(coupling::kSmallestControlMarkerSpacing) +
+          " (with markers closer than the lattice spacing a sphere moving through the liquid "
+          "feels 0.78-0.86 of the drag it feels held, at 1 dx 0.995; docs/coupling.md)");
     if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
       throw InputError(
           "numerics.immersed_boundary.sweeps: control forcing makes one correction "
@@ -480,12 +487,9 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
 
   if (modules_of(c.scene).liquid && c.numerics.input_radius_given) {
     // A hand-given a_g replaces the calibration, not the validation: the
-    // scheme must still be one the project offers (calibrated at some a, or
-    // control forcing, whose calibration is kept beside the code but not
-    // shipped: its radius varies with the solid fraction by more than the
-    // 0.02 dx every shipped entry meets; docs/coupling.md).
+    // scheme must still be one the project offers (calibrated at some a).
     const auto& table = calibration::CalibrationTable::shipped();
-    bool offered = c.numerics.coupling.control();
+    bool offered = false;
     std::string names;
     for (const auto& e : table.entries()) {
       offered = offered || e.scheme.same_calibration(c.numerics.coupling);
@@ -504,13 +508,6 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     // a_g for this a from the shipped calibration, interpolated in log(nu)
     // between the calibrated viscosities around this one
     const auto& table = calibration::CalibrationTable::shipped();
-    if (c.numerics.coupling.control() && !table.has(a, c.numerics.coupling))
-      throw InputError(
-          "numerics.immersed_boundary = " + scheme_fields(c.numerics.coupling) +
-          ": control forcing's hydrodynamic radius is not shipped (it varies with the solid "
-          "fraction by about 0.04 dx, above the 0.02 dx of the shipped calibration; "
-          "docs/coupling.md); give numerics.input_radius from its calibration there "
-          "(a_g = 2.9287 for a_over_dx = 4 at viscosity 0.02)");
     if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
       refuse_beyond_validated_phi();
     if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))

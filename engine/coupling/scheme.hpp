@@ -93,8 +93,9 @@ inline std::optional<Forcing> forcing_from_name(const std::string& name) {
 // Where the loop is stable was measured (docs/coupling.md, "Control forcing:
 // where it is stable"; bench_control_stability, 1e5 steps per point, a = 4 at
 // nu 0.01-0.04 and a = 6 at nu 0.005-0.02, a sphere held in a flow and one
-// settling at Re 12): held spheres are stable up to the largest gains tried
-// (integral 4); a settling sphere goes unstable within 100 steps, in a
+// settling at a nominal Re 12): held spheres are stable up to the largest
+// gains tried (integral 4); a settling sphere goes unstable within 40-225
+// steps, in a
 // period-2 mode, once the loop's gain at that frequency, integral +
 // 2 proportional, reaches 4 (integral 4; integral 2 with proportional 1),
 // and stays bounded at 3 (integral 3; integral 1 with proportional 1). One
@@ -144,8 +145,8 @@ struct Scheme {
     return std::abs(marker_spacing - o.marker_spacing) <= 1e-9 && sweeps == o.sweeps &&
            kernel == o.kernel && forcing == o.forcing;
   }
-  // "markers 0.7 dx apart, 2 sweeps, roma3 kernel"; "markers 0.7 dx apart,
-  // control forcing (gains 0.5, 0), roma3 kernel"; "partially saturated cells"
+  // "markers 0.7 dx apart, 2 sweeps, roma3 kernel"; "markers 1 dx apart,
+  // control forcing (gains 2, 0), roma3 kernel"; "partially saturated cells"
   std::string describe() const {
     if (!immersed_boundary()) return "partially saturated cells";
     char spacing[32];
@@ -176,8 +177,18 @@ inline constexpr Scheme kPaperScheme{};
 // the draft and standard presets use it where it is validated.
 inline constexpr Scheme kOneSweepScheme{1.0, 1, Kernel::roma3};
 
-// The paper's own forcing: its markers (0.7 dx) under control forcing.
-inline constexpr Scheme kControlScheme{0.7, 1, Kernel::roma3, Forcing::control};
+// The paper's own forcing, control forcing, with markers 1 dx apart. Not the
+// paper's 0.7 dx: with markers denser than the lattice a sphere dragged
+// through the liquid feels 0.78-0.86 of the drag it feels held (nu 0.1-0.02,
+// Re 1), at 1 dx apart 0.995 and at 1.2 dx 1.000 (docs/coupling.md,
+// "Galilean invariance"). The likely reason: closer than dx the markers'
+// slips are not independent (more markers than cells under their kernels),
+// so the integral action, which drives every marker's slip to zero, has no
+// unique force to settle on and what it settles on depends on how the sphere
+// moves across the grid.
+inline constexpr Scheme kControlScheme{1.0, 1, Kernel::roma3, Forcing::control};
+// Control forcing's densest markers (dx): see kControlScheme.
+inline constexpr double kSmallestControlMarkerSpacing = 1.0;
 
 // Partially saturated cells: no markers.
 inline constexpr Scheme kPartiallySaturatedScheme{.method = Method::partially_saturated};

@@ -16,6 +16,7 @@
 // each sphere since the previous step; the sphere equations add that change
 // (Kempe & Froehlich 2012), so that liquid and spheres together conserve
 // momentum to round-off whatever the scheme (docs/model.md, section 1).
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>

@@ -642,25 +642,35 @@ TEST(SuspensionCaseCoupling, ControlGainsOutsideTheMeasuredStableRegionAreRefuse
   }
 }
 
-// Control forcing's radius is not shipped (it varies with the solid fraction
-// by more than the shipped entries' 0.02 dx): a case gets it by hand, in the
-// range where control forcing puts its wall (up to 1.5 dx outside its
-// markers). Partially saturated cells come from the shipped table. Each is
-// written into the canonical case, so that runs of different schemes never
-// share an identity.
-TEST(SuspensionCaseCoupling, ControlForcingByHandAndPartiallySaturatedCellsFromTheTable) {
+// Control forcing (markers 1 dx apart) and partially saturated cells take
+// their radius from the shipped table like the other schemes; a hand-given
+// radius must lie where the scheme puts its wall (control forcing: up to
+// 1.5 dx outside its markers). Markers closer than 1 dx are refused for
+// control forcing (not Galilean invariant there). Each scheme is written into
+// the canonical case, so that runs of different schemes never share an
+// identity.
+TEST(SuspensionCaseCoupling, ControlForcingAndPartiallySaturatedCellsFromTheTable) {
   json control = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "standard",
       "numerics": {"a_over_dx": 4, "U_inf": 0.03, "immersed_boundary": {"forcing": "control"}}})");
-  EXPECT_THAT(refusal(control),
-              AllOf(HasSubstr("numerics.input_radius"), HasSubstr("docs/coupling.md")));
-  control["numerics"]["input_radius"] = 2.4;
-  EXPECT_THAT(refusal(control), AllOf(HasSubstr("input_radius"), HasSubstr("1.5 dx")));
-  control["numerics"]["input_radius"] = 2.9287;
   const SuspensionCase c = parse_suspension_case(control);
   EXPECT_TRUE(c.numerics.coupling.control());
-  EXPECT_EQ(c.numerics.coupling.marker_spacing, 0.7);
+  EXPECT_EQ(c.numerics.coupling.marker_spacing, 1.0);
+  // nu = U_inf 2a / Re_inf = 0.02: the shipped entry's a_g (3.5089) itself
+  EXPECT_NEAR(c.numerics.input_radius, 3.5089, 1e-4);
   EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"]["forcing"], "control");
   EXPECT_EQ(c.to_json()["numerics"]["immersed_boundary"]["gains"]["integral"], 2.0);
+
+  json dense = control;
+  dense["numerics"]["immersed_boundary"]["marker_spacing"] = 0.7;
+  EXPECT_THAT(refusal(dense), AllOf(HasSubstr("numerics.immersed_boundary.marker_spacing = 0.7"),
+                                    HasSubstr(">= 1"), HasSubstr("held")));
+  control["numerics"]["input_radius"] = 2.4;
+  EXPECT_THAT(refusal(control), AllOf(HasSubstr("input_radius"), HasSubstr("1.5 dx")));
+  json uncalibrated = control;
+  uncalibrated["numerics"].erase("input_radius");
+  uncalibrated["numerics"]["a_over_dx"] = 8;  // control forcing is calibrated at a = 4 only
+  EXPECT_THAT(refusal(uncalibrated), AllOf(HasSubstr("not calibrated at numerics.a_over_dx = 8"),
+                                           HasSubstr("--forcing control --marker-spacing 1")));
 
   const SuspensionCase psm = parse_suspension_case(json::parse(R"({"scene": "suspension",
       "phi": 0.2, "fidelity": "standard",

@@ -60,6 +60,32 @@ TEST_F(Calibrate, RefusesNonFiniteNumbersNamingTheOption) {
   }
 }
 
+// Options of a scheme other than the chosen one were ignored (a radius entry
+// written for a scheme the user did not mean); unstable gains and control
+// forcing's dense markers ran for minutes before the lattice said why.
+TEST_F(Calibrate, RefusesOptionsOfAnotherSchemeAndControlForcingOutsideItsRegion) {
+  const std::string table = (dir_ / "t.json").string();
+  const std::vector<std::pair<std::vector<std::string>, std::vector<std::string>>> cases = {
+      {{"--gains", "2", "0"}, {"--gains", "only with --forcing control"}},
+      {{"--forcing", "control", "--sweeps", "2"}, {"--sweeps", "one correction per step"}},
+      {{"--coupling", "partially-saturated", "--marker-spacing", "1"},
+       {"--marker-spacing", "no markers"}},
+      {{"--coupling", "partially-saturated", "--kernel", "linear2"}, {"--kernel", "no markers"}},
+      {{"--forcing", "control", "--marker-spacing", "0.7"},
+       {"--marker-spacing 0.7", "must be >= 1", "held"}},
+      {{"--forcing", "control", "--gains", "4", "0"},
+       {"--gains 4 0", "integral + 2 proportional <= 3"}},
+      {{"--forcing", "control", "--gains", "0.5", "0"}, {"--gains 0.5 0", "integral >= 1"}}};
+  for (const auto& [options, words] : cases) {
+    std::vector<std::string> args = {"calibrate", "--table", table, "--radius", "4"};
+    args.insert(args.end(), options.begin(), options.end());
+    t::Output o;
+    const double s = seconds_of([&] { o = t::run(flocsim(args)); });
+    SCOPED_TRACE(options.front());
+    expect_refused_up_front(o, words, table, s);
+  }
+}
+
 // `--table nodir/t.json` (or a read-only folder) computed for minutes and then
 // failed without a reason; a folder gave "parse error ... unexpected end of
 // input"; a close-pair table gave "key 'input_radius' not found", no file named.

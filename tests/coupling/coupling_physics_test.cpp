@@ -89,18 +89,33 @@ TEST(ControlForcing, SettlingSphereGoesUnstableJustBeyondTheAcceptedGains) {
 // breaks it at O(Ma^2) (5e-4 here) and by where the sphere sits on the grid,
 // which the dragged sphere averages over as it crosses the cells: the held
 // drag is averaged over a node-aligned and a mid-cell place (shifts 0 and
-// 0.5). Within 1 % with direct forcing and partially saturated cells;
-// control forcing, as implemented, does not meet this (11-17 % less drag
-// dragged than held, docs/coupling.md) and is not tested here.
+// 0.5). Within 1 % with every offered scheme. Control forcing is calibrated
+// at nu = 0.02 only: its a = 4 radius there (3.5089) serves.
+double dragged_over_held(const coupling::Scheme& scheme, double input_radius = 0) {
+  const double dragged = testing_support::drag_at_re1(scheme, false, 0, input_radius);
+  const double held = 0.5 * (testing_support::drag_at_re1(scheme, true, 0.0, input_radius) +
+                             testing_support::drag_at_re1(scheme, true, 0.5, input_radius));
+  std::printf("%s: dragged %.4f, held %.4f, dragged / held %.4f\n", scheme.describe().c_str(),
+              dragged, held, dragged / held);
+  return dragged / held;
+}
+
 TEST(GalileanInvariance, DraggedAndHeldSpheresFeelTheSameDrag) {
   for (const coupling::Scheme& scheme :
-       {coupling::kPaperScheme, coupling::kOneSweepScheme, coupling::kPartiallySaturatedScheme}) {
-    const double dragged = testing_support::drag_at_re1(scheme, false);
-    const double held = 0.5 * (testing_support::drag_at_re1(scheme, true, 0.0) +
-                               testing_support::drag_at_re1(scheme, true, 0.5));
-    std::printf("%s: dragged %.4f, held %.4f\n", scheme.describe().c_str(), dragged, held);
-    EXPECT_NEAR(dragged / held, 1.0, 0.01) << scheme.describe();
-  }
+       {coupling::kPaperScheme, coupling::kOneSweepScheme, coupling::kPartiallySaturatedScheme})
+    EXPECT_NEAR(dragged_over_held(scheme), 1.0, 0.01) << scheme.describe();
+  EXPECT_NEAR(dragged_over_held(coupling::kControlScheme, 3.5089), 1.0, 0.01);
+}
+
+// Why control forcing refuses markers closer than 1 dx: at the paper's
+// 0.7 dx a dragged sphere feels 14-22 % less drag than a held one (0.83
+// here; 0.78 and 0.85 in bench_coupling_noise at nu 0.1 and 0.02,
+// docs/coupling.md), with the gains and kernel that are invariant to 0.4 % at
+// 1 dx above.
+TEST(ControlForcing, MarkersCloserThanTheLatticeSpacingAreNotGalileanInvariant) {
+  coupling::Scheme dense = coupling::kControlScheme;
+  dense.marker_spacing = 0.7;
+  EXPECT_LT(dragged_over_held(dense, 2.9287), 0.9);
 }
 
 }  // namespace

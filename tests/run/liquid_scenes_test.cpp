@@ -184,7 +184,7 @@ TEST(LiquidScenes, SuspensionStopAndResumeIsBitIdentical) {
 // markers' forces go into the checkpoint with the rest of the state).
 TEST(LiquidScenes, OtherCouplingsStopAndResumeBitIdentically) {
   for (const char* numerics :
-       {R"({"U_inf": 0.05, "input_radius": 2.9287, "immersed_boundary": {"forcing": "control"}})",
+       {R"({"U_inf": 0.05, "input_radius": 3.5, "immersed_boundary": {"forcing": "control"}})",
         R"({"U_inf": 0.05, "coupling": "partially-saturated"})"}) {
     json doc = json::parse(R"({
       "scene": "suspension", "fidelity": "draft", "phi": 0.2, "Re_inf": 12, "du_over_Uinf": 0.5,
