@@ -582,8 +582,9 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
 // The real worker: the CI sweep with `flocsim run`, then a real run killed with
 // SIGKILL and resumed from its HDF5 checkpoint.
 TEST_F(Orchestrator, PlanRefusesWhatLaunchRefusesAndCountsTheRunsLatticeUpdates) {
-  // Three points at the draft preset (a = 4, 64 x 32 x 32 cells, 49 spheres):
-  // Re_inf 24 runs, 48 and 72 are refused (a = 4 caps Re_inf at 40). Stage 1
+  // Three points at the draft preset (a = 4, 64 x 32 x 32 cells, 49 spheres)
+  // and U_inf 0.03: Re_inf 24 runs (nu = 2 a U_inf / Re_inf = 0.01), 48 and 72
+  // are refused (nu 0.005 and 0.0033, below the floor 0.01 at a = 4). Stage 1
   // has a fixed length (stage1_min = stage1_max), so the run's length is known
   // exactly: the plan's lattice updates must be the run's own steps x cells.
   json s{{"name", "plancheck"},
