@@ -52,9 +52,10 @@ void for_each_box_run(const std::array<int, 3>& lo, const std::int16_t* rows, in
 std::vector<std::vector<std::vector<int>>> make_colours(
     const std::vector<std::array<int, 3>>& origins, int box, const lattice::Extent& extent);
 
-// One bit per 16-cell chunk of every lattice row: which chunks hold cells of
-// interest (the cells some sphere reads, or holds a force or a solid fraction
-// on). Chunk c of row r covers x = 16 c .. 16 c + 15.
+// One bit per chunk of kChunk cells of every lattice row: which chunks hold
+// cells of interest (the cells some sphere reads, or holds a force on).
+// Chunk c of row r covers x = kChunk c .. kChunk c + kChunk - 1: one vector of
+// floats, so that a marked stretch is swept in whole vectors.
 class ChunkMask {
  public:
   static constexpr int kChunk = 16;

@@ -559,7 +559,8 @@ void ImmersedBoundary<Real>::read_liquid_velocity(lattice::ForcedLiquid<Real>& l
       }
       int c1 = c + 1;
       while (c1 < chunks && coupling::ChunkMask::has(need, c1)) ++c1;
-      const int x0 = 16 * c, x1 = std::min(e.nx, 16 * c1);
+      const int x0 = coupling::ChunkMask::kChunk * c,
+                x1 = std::min(e.nx, coupling::ChunkMask::kChunk * c1);
       liquid.macroscopic_row_without_force_field(x0, x1 - x0, y, z, out + 4 * x0);
       c = c1;
     }
@@ -567,7 +568,8 @@ void ImmersedBoundary<Real>::read_liquid_velocity(lattice::ForcedLiquid<Real>& l
       std::uint64_t* held = held_.row(r);
       for (int c = 0; c < chunks; ++c)
         if (coupling::ChunkMask::has(held, c)) {
-          const int x0 = 16 * c, count = std::min(16, e.nx - x0);
+          const int x0 = coupling::ChunkMask::kChunk * c,
+                    count = std::min(coupling::ChunkMask::kChunk, e.nx - x0);
           for (int d = 0; d < 3; ++d)
             std::fill_n(field.row(d, static_cast<long>(r)) + x0, count, Real(0));
         }

@@ -2,11 +2,13 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "engine/lattice/partially_saturated_collision.hpp"
 #include "engine/lattice/trt_collision.hpp"
@@ -123,69 +125,6 @@ void FluidLattice<Real>::enable_force_field() {
   const long n = static_cast<long>(cells);
 #pragma omp parallel for schedule(static)
   for (long c = 0; c < n; ++c) f[0][c] = f[1][c] = f[2][c] = Real(0);
-}
-
-template <class Real>
-void FluidLattice<Real>::enable_solid_coverage() {
-  if (has_solid_coverage()) return;
-  // One buffer for the eight per-cell arrays, their starts skewed within a
-  // page (96 + 192 k bytes, between the populations' 192 k) so that the same
-  // cell of each array falls in a different cache set.
-  const std::size_t page_elements = kPageBytes / sizeof(Real);
-  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
-  coverage_stride_ = static_cast<long>((cells + page_elements - 1) / page_elements * page_elements +
-                                       kStrideSkewBytes / sizeof(Real));
-  const long skew = static_cast<long>(kStrideSkewBytes / 2 / sizeof(Real));
-  coverage_ = allocate(static_cast<std::size_t>(skew + kCoverageArrays * coverage_stride_));
-  Real* p = coverage_.get();
-  const long n = skew + kCoverageArrays * coverage_stride_;
-#pragma omp parallel for schedule(static)
-  for (long c = 0; c < n; ++c) p[c] = Real(0);
-  chunk_words_ =
-      ((extent_.nx + SolidCoverageView<Real>::kChunk - 1) / SolidCoverageView<Real>::kChunk + 63) /
-      64;
-  covered_chunks_.assign(static_cast<std::size_t>(extent_.rows()) * chunk_words_, 0);
-}
-
-template <class Real>
-SolidCoverageView<Real> FluidLattice<Real>::coverage_view() const {
-  SolidCoverageView<Real> v;
-  v.extent = extent_;
-  Real* base = coverage_.get() + kStrideSkewBytes / 2 / sizeof(Real);
-  Real* array[kCoverageArrays];
-  for (int k = 0; k < kCoverageArrays; ++k) array[k] = base + k * coverage_stride_;
-  v.coverage = array[0];
-  v.density = array[4];
-  for (int d = 0; d < 3; ++d) {
-    v.solid_velocity[d] = array[1 + d];
-    v.momentum[d] = array[5 + d];
-  }
-  v.chunks = const_cast<std::uint64_t*>(covered_chunks_.data());
-  v.chunk_words = chunk_words_;
-  return v;
-}
-
-template <class Real>
-SolidCoverageView<Real> FluidLattice<Real>::solid_coverage() {
-  enable_solid_coverage();
-  return coverage_view();
-}
-
-template <class Real>
-SolidCoverageView<const Real> FluidLattice<Real>::solid_coverage_if_set() const {
-  if (!has_solid_coverage()) return {};
-  const SolidCoverageView<Real> v = coverage_view();
-  SolidCoverageView<const Real> c;
-  c.extent = v.extent;
-  c.coverage = v.coverage;
-  c.density = v.density;
-  for (int d = 0; d < 3; ++d) {
-    c.solid_velocity[d] = v.solid_velocity[d];
-    c.momentum[d] = v.momentum[d];
-  }
-  c.chunks = v.chunks;
-  c.chunk_words = v.chunk_words;
-  return c;
 }
 
 template <class Real>
@@ -400,7 +339,7 @@ std::size_t FluidLattice<Real>::bytes_per_cell_update() const {
 
 template <class Real>
 void FluidLattice<Real>::step() {
-  if (has_solid_coverage()) {
+  if (solid_coverage_) {
     if (has_force_field())
       step_kernel<true, true>();
     else
@@ -410,8 +349,41 @@ void FluidLattice<Real>::step() {
   } else {
     step_kernel<false, false>();
   }
+  solid_coverage_ = nullptr;  // one step: the coupling sets it again
   ++time_step_;
 }
+
+namespace {
+
+// The buffers one thread lends the partially saturated cells for each row it
+// steps (forced_liquid.hpp: CoveredRow), zero where the row format wants zero.
+template <class Real>
+class CoveredRowBuffers {
+ public:
+  explicit CoveredRowBuffers(int nx)
+      : cells_(static_cast<std::size_t>(nx) + CoveredRow<Real>::kPad) {
+    const std::size_t cells = cells_;
+    values_.assign(8 * cells, Real(0));
+    row_.nx = nx;
+    Real* p = values_.data();
+    row_.coverage = p;
+    row_.density = p + 4 * cells;
+    for (int d = 0; d < 3; ++d) {
+      row_.solid_velocity[d] = p + (1 + d) * cells;
+      row_.momentum[d] = p + (5 + d) * cells;
+    }
+  }
+  CoveredRow<Real>& row() { return row_; }
+  // Back to zero coverage after a covered row (eps and V lie first, together).
+  void reset() { std::fill_n(values_.data(), 4 * cells_, Real(0)); }
+
+ private:
+  std::size_t cells_ = 0;
+  std::vector<Real> values_;
+  CoveredRow<Real> row_;
+};
+
+}  // namespace
 
 template <class Real>
 template <bool kForceField, bool kCoverage>
@@ -431,11 +403,26 @@ void FluidLattice<Real>::step_kernel() {
   const Real* const Fxs = force_x_.get();
   const Real* const Fys = force_y_.get();
   const Real* const Fzs = force_z_.get();
-  const SolidCoverageView<Real> cover = kCoverage ? coverage_view() : SolidCoverageView<Real>{};
+  SolidCoverage<Real>* const solid = kCoverage ? solid_coverage_ : nullptr;
+  if constexpr (kCoverage) solid->begin_step(omp_get_max_threads());
 
-#pragma omp parallel for collapse(2) schedule(static)
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y) {
+#pragma omp parallel
+  {
+    // per thread: the row-local coverage buffers (a few KiB, in cache)
+    CoveredRowBuffers<Real> buffers(kCoverage ? nx : 0);
+    CoveredRow<Real>& cover = buffers.row();
+    const Real* const eps = cover.coverage;
+    const Real* const Vx = cover.solid_velocity[0];
+    const Real* const Vy = cover.solid_velocity[1];
+    const Real* const Vz = cover.solid_velocity[2];
+    Real* const rho_seen = cover.density;
+    Real* const jx_seen = cover.momentum[0];
+    Real* const jy_seen = cover.momentum[1];
+    Real* const jz_seen = cover.momentum[2];
+    if constexpr (kCoverage) cover.thread = omp_get_thread_num();
+
+    // One lattice row: collision and streaming of cells (0 .. nx - 1, y, z).
+    const auto step_row = [&](int z, int y) FLOCSIM_LAMBDA_ALWAYS_INLINE {
       const long row = static_cast<long>(nx) * (y + static_cast<long>(ny) * z);
       // Start of the neighbouring rows (y + dy, z + dz), dy, dz in {-1, 0, 1},
       // periodic: neighbour_row[dz + 1][dy + 1]. Only unit offsets occur, so
@@ -485,7 +472,8 @@ void FluidLattice<Real>::step_kernel() {
                         };
 
       // A cell that spheres partly cover (partially_saturated_collision.hpp):
-      // it reads its coverage and reports the density and momentum it saw.
+      // it reads its coverage from the row's buffers and leaves there the
+      // density and momentum it saw.
       auto update_covered = [&](int x, const Real* const* ld, Real* const* st, int lx,
                                 int sx) FLOCSIM_LAMBDA_ALWAYS_INLINE {
         Real f[kQ];
@@ -497,36 +485,35 @@ void FluidLattice<Real>::step_kernel() {
           Fcy += Fy[x];
           Fcz += Fz[x];
         }
-        const long c = row + x;
-        collide_partially_saturated(f, Fcx, Fcy, Fcz, cover.coverage[c], cover.solid_velocity[0][c],
-                                    cover.solid_velocity[1][c], cover.solid_velocity[2][c], k,
-                                    cover.density[c], cover.momentum[0][c], cover.momentum[1][c],
-                                    cover.momentum[2][c]);
+        collide_partially_saturated(f, Fcx, Fcy, Fcz, eps[x], Vx[x], Vy[x], Vz[x], k, rho_seen[x],
+                                    jx_seen[x], jy_seen[x], jz_seen[x]);
 #pragma GCC unroll 19
         for (int i = 0; i < kQ; ++i) st[i][sx] = f[i];
       };
 
+      const long row_index = static_cast<long>(y) + static_cast<long>(ny) * z;
+      bool covered_row = false;
+      if constexpr (kCoverage) {
+        cover.row = row_index;
+        cover.y = y;
+        cover.z = z;
+        for (int d = 0; d < 3; ++d) cover.force[d] = nullptr;
+        if constexpr (kForceField) {
+          cover.force[0] = Fx;
+          cover.force[1] = Fy;
+          cover.force[2] = Fz;
+        }
+        covered_row = solid->cover(cover);
+      }
       // Interior of the row: every shifted pointer stays inside the row, so
       // the loop is a plain unit-stride sweep the compiler vectorises.
       const int x_begin = even ? 0 : 1;
       const int x_end = even ? nx : nx - 1;
-      if constexpr (kCoverage) {
-        // chunk by chunk: covered chunks take the blended collision
-        const std::uint64_t* chunks =
-            cover.chunk_row(static_cast<long>(y) + static_cast<long>(ny) * z);
-        constexpr int C = SolidCoverageView<Real>::kChunk;
-        for (int x0 = x_begin; x0 < x_end;) {
-          const int chunk = x0 / C;
-          const int x1 = std::min(x_end, (chunk + 1) * C);
-          if (chunks[chunk / 64] >> (chunk % 64) & 1) {
+      if (covered_row) {
+        // the whole row blended, its uncovered cells with eps = 0
+        // (forced_liquid.hpp: CoveredRow says why)
 #pragma omp simd
-            for (int x = x0; x < x1; ++x) update_covered(x, load, store, x, x);
-          } else {
-#pragma omp simd
-            for (int x = x0; x < x1; ++x) update(x, load, store, x, x);
-          }
-          x0 = x1;
-        }
+        for (int x = x_begin; x < x_end; ++x) update_covered(x, load, store, x, x);
       } else {
 #pragma omp simd
         for (int x = x_begin; x < x_end; ++x) update(x, load, store, x, x);
@@ -545,19 +532,31 @@ void FluidLattice<Real>::step_kernel() {
             ld[i] = load[i] + cx[i] + (from < 0 ? from + nx : from >= nx ? from - nx : from);
             st[i] = store[i] - cx[i] + (to < 0 ? to + nx : to >= nx ? to - nx : to);
           }
-          if constexpr (kCoverage) {
-            const std::uint64_t* chunks =
-                cover.chunk_row(static_cast<long>(y) + static_cast<long>(ny) * z);
-            const int chunk = x / SolidCoverageView<Real>::kChunk;
-            if (chunks[chunk / 64] >> (chunk % 64) & 1) {
-              update_covered(x, ld, st, 0, 0);
-              continue;
-            }
-          }
-          update(x, ld, st, 0, 0);
+          if (covered_row)
+            update_covered(x, ld, st, 0, 0);
+          else
+            update(x, ld, st, 0, 0);
         }
       }
+
+      if constexpr (kCoverage)
+        if (covered_row) {
+          solid->exchange(cover);
+          buffers.reset();
+        }
+    };
+
+    if constexpr (kCoverage) {
+      // each z plane on one thread, its rows in order (forced_liquid.hpp)
+#pragma omp for schedule(static)
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y) step_row(z, y);
+    } else {
+#pragma omp for collapse(2) schedule(static)
+      for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y) step_row(z, y);
     }
+  }
 }
 
 template class FluidLattice<float>;

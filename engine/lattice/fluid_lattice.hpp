@@ -65,13 +65,10 @@ class FluidLattice final : public ForcedLiquid<Real> {
   // The per-cell force field (enabled on first use); index with cell_index.
   ForceFieldView<Real> force_field() override;
   ForceFieldView<const Real> force_field_if_set() const override;
-  // Partially saturated cells (forced_liquid.hpp): the per-cell solid
-  // coverage, allocated zero on first use; the kernel then blends the
-  // collision of the covered chunks (partially_saturated_collision.hpp).
-  void enable_solid_coverage();
-  bool has_solid_coverage() const { return coverage_ != nullptr; }
-  SolidCoverageView<Real> solid_coverage() override;
-  SolidCoverageView<const Real> solid_coverage_if_set() const override;
+  // Partially saturated cells (forced_liquid.hpp): the next step blends the
+  // collision of the rows `coverage` covers (partially_saturated_collision.hpp).
+  void set_solid_coverage(SolidCoverage<Real>* coverage) override { solid_coverage_ = coverage; }
+  const SolidCoverage<Real>* pending_solid_coverage() const override { return solid_coverage_; }
 
   // ---- state ----------------------------------------------------------------
   // Sets every cell to the equilibrium of the given density and (physical,
@@ -119,7 +116,6 @@ class FluidLattice final : public ForcedLiquid<Real> {
  private:
   template <bool kForceField, bool kCoverage>
   void step_kernel();
-  SolidCoverageView<Real> coverage_view() const;
   Real* storage(int i) { return populations_.get() + i * stride_; }
   const Real* storage(int i) const { return populations_.get() + i * stride_; }
   // One cell of macroscopic_row_without_force_field (x, y, z inside the box);
@@ -138,13 +134,7 @@ class FluidLattice final : public ForcedLiquid<Real> {
   long stride_ = 0;  // elements between direction arrays (padded)
   Buffer populations_;
   Buffer force_x_, force_y_, force_z_;
-  // solid coverage, one buffer of kCoverageArrays arrays kept coverage_stride_
-  // apart: eps, sum eps u_s (3); the density and momentum the collision saw (4)
-  static constexpr int kCoverageArrays = 8;
-  Buffer coverage_;
-  long coverage_stride_ = 0;
-  std::vector<std::uint64_t> covered_chunks_;
-  int chunk_words_ = 0;
+  SolidCoverage<Real>* solid_coverage_ = nullptr;  // for the next step only
   Vector3 body_force_;
   long time_step_ = 0;
 };

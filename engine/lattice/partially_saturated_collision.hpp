@@ -67,35 +67,36 @@ FLOCSIM_ALWAYS_INLINE void collide_partially_saturated(Real (&f)[d3q19::kQ], Rea
   const Real ssq15 = Real(1.5) * (sx * sx + sy * sy + sz * sz);
   const Real uF3 = Real(3) * (ux * Fx + uy * Fy + uz * Fz);
   const Real liquid = Real(1) - B;
-  // h: an antisymmetric term of momentum -omega_minus F / 2 (per pair i:
-  // -omega_minus / 2 * 3 w_i c_i . F), in units of force_minus * force_minus_term
-  const Real h_factor = Real(-0.5) * k.omega_minus;
+  // The update of the pair (i, opposite) above, per population:
+  //   d_plus  = -omega_plus (f_plus - eq_plus) + (1 - B) force_plus_factor force_plus
+  //             + B (Feq_plus(u_s) - Feq_plus(u)),
+  //   d_minus = -omega_minus (f_minus - eq_minus) + (1 - B) force_minus_factor force_minus
+  //             + B (Feq_minus(u_s) - Feq_minus(u) + h),
+  // with the equilibria and Guo terms of trt_collision.hpp and h of momentum
+  // -omega_minus F / 2. Collected per power of c.u, c.s and c.F the cell's
+  // coefficients are computed once and each pair costs a few multiply-adds:
+  //   d_plus  = -omega_plus f_plus + w_i (K + (A_u c.u + A_F c.F) c.u + A_s (c.s)^2),
+  //   d_minus = -omega_minus f_minus + w_i (M_u c.u + M_s c.s + M_F c.F).
+  const Real op = k.omega_plus, om = k.omega_minus;
+  const Real rho_B = rho * B;
+  const Real K = op * drho - rho * ((op - B) * usq15) - rho_B * ssq15 - liquid * k.force_plus * uF3;
+  const Real A_u = Real(4.5) * rho * (op - B), A_s = Real(4.5) * rho_B;
+  const Real A_F = Real(9) * liquid * k.force_plus;
+  const Real M_u = Real(3) * rho * (om - B), M_s = Real(3) * rho_B;
+  // h: per pair -omega_minus / 2 * 3 w_i c_i . F
+  const Real M_F = Real(3) * (liquid * k.force_minus - Real(0.5) * om * B);
 
-  {
-    const Real w0 = Real(kWeightRest);
-    const Real eq = w0 * (drho - rho * usq15);
-    const Real shift = w0 * rho * (usq15 - ssq15);  // Feq_0(u_s) - Feq_0(u)
-    f[0] += -k.omega_plus * (f[0] - eq) - liquid * k.force_plus * w0 * uF3 + B * shift;
-  }
+  f[0] += -op * f[0] + Real(kWeightRest) * K;
 #pragma GCC unroll 9
   for (int i = 1; i < kQ; i += 2) {
     const Real wi = Real(w[i]);
     const Real cu = Real(cx[i]) * ux + Real(cy[i]) * uy + Real(cz[i]) * uz;
     const Real cs = Real(cx[i]) * sx + Real(cy[i]) * sy + Real(cz[i]) * sz;
     const Real cF = Real(cx[i]) * Fx + Real(cy[i]) * Fy + Real(cz[i]) * Fz;
-    const Real eq_plus = wi * (drho + rho * (Real(4.5) * cu * cu - usq15));
-    const Real eq_minus = wi * rho * Real(3) * cu;
-    const Real force_plus = wi * (Real(9) * cu * cF - uF3);
-    const Real force_minus = wi * Real(3) * cF;
-    const Real shift_plus = wi * rho * (Real(4.5) * (cs * cs - cu * cu) - ssq15 + usq15);
-    const Real shift_minus = wi * rho * Real(3) * (cs - cu);
     const Real f_plus = Real(0.5) * (f[i] + f[i + 1]);
     const Real f_minus = Real(0.5) * (f[i] - f[i + 1]);
-    const Real d_plus =
-        -k.omega_plus * (f_plus - eq_plus) + liquid * k.force_plus * force_plus + B * shift_plus;
-    const Real d_minus = -k.omega_minus * (f_minus - eq_minus) +
-                         liquid * k.force_minus * force_minus +
-                         B * (shift_minus + h_factor * force_minus);
+    const Real d_plus = -op * f_plus + wi * (K + (A_u * cu + A_F * cF) * cu + A_s * cs * cs);
+    const Real d_minus = -om * f_minus + wi * (M_u * cu + M_s * cs + M_F * cF);
     f[i] += d_plus + d_minus;
     f[i + 1] += d_plus - d_minus;
   }

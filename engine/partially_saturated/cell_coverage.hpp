@@ -54,22 +54,22 @@ inline double cell_coverage(double rx, double ry, double rz, double a) {
   return cube_fraction_below_plane(rx / r, ry / r, rz / r, d);
 }
 
-// cell_coverage() of n cells at (rx[q], ry[q], rz[q]) from the sphere's
-// centre, into eps[0 .. n - 1]: the same numbers, without branches so that
-// the loop vectorises (the partially saturated cells evaluate it for every
-// covered cell of every sphere each step). Positions and fractions are
-// stored in single precision; the cubic is evaluated in double, whose
+// cell_coverage() without branches, so that loops over cells vectorise (the
+// partially saturated cells evaluate it for every covered cell of every
+// sphere each step): one sphere's constants, then the fraction of the cell
+// centred at (x, y, z) from its centre. Positions come in single precision
+// (as the cells are listed); the cubic is evaluated in double, whose
 // cancellation error stays below 1e-9 where the normal is near an axis.
-inline void list_coverage(int n, const float* rx, const float* ry, const float* rz, double a,
-                          float* eps) {
-  constexpr double kHalfDiagonal = 0.8660254037844386;
-  constexpr double kSmallest = 1e-4;
-  const double inner = a - kHalfDiagonal, outer = a + kHalfDiagonal;
-  const double inner2 = inner * inner, outer2 = outer * outer;
-  const double plane = a - 1.0 / (12.0 * a);
-#pragma omp simd
-  for (int q = 0; q < n; ++q) {
-    const double x = rx[q], y = ry[q], z = rz[q];
+struct SphereCoverage {
+  double inner2, outer2, plane;  // (a - sqrt(3)/2)^2, (a + sqrt(3)/2)^2, a - 1/(12 a)
+  explicit SphereCoverage(double a)
+      : inner2((a - 0.8660254037844386) * (a - 0.8660254037844386)),
+        outer2((a + 0.8660254037844386) * (a + 0.8660254037844386)),
+        plane(a - 1.0 / (12.0 * a)) {}
+
+  float operator()(float rx, float ry, float rz) const {
+    constexpr double kSmallest = 1e-4;
+    const double x = rx, y = ry, z = rz;
     const double r2 = x * x + y * y + z * z;
     const double r = std::sqrt(r2 > 0 ? r2 : 1.0);  // the centre cell is inside anyway
     const double inv = 1.0 / r;
@@ -88,8 +88,8 @@ inline void list_coverage(int n, const float* rx, const float* ry, const float* 
                (6.0 * m0 * m1 * m2);
     v = std::min(std::max(v, 0.0), 1.0);
     const double cut = upper ? 1.0 - v : v;
-    eps[q] = static_cast<float>(r2 <= inner2 ? 1.0 : (r2 >= outer2 ? 0.0 : cut));
+    return static_cast<float>(r2 <= inner2 ? 1.0 : (r2 >= outer2 ? 0.0 : cut));
   }
-}
+};
 
 }  // namespace flocsim::partially_saturated

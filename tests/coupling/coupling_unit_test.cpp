@@ -4,8 +4,11 @@
 // collision of a covered cell against what it must do to density, momentum
 // and velocity, and the control-forcing law against its definition.
 #include <gtest/gtest.h>
+#include <omp.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -13,12 +16,15 @@
 #include "engine/immersed_boundary/control_forcing.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/partially_saturated/cell_coverage.hpp"
+#include "engine/partially_saturated/partially_saturated_cells.hpp"
+#include "tests/coupling/partially_saturated_reference.hpp"
 
 namespace flocsim {
 namespace {
 
 using partially_saturated::cell_coverage;
 using partially_saturated::cube_fraction_below_plane;
+using spheres::Vec3;
 
 // The fraction of the unit cube below the plane n . x = d, counted on a
 // regular grid of k^3 sub-cell centres: error about 1/k for a cut plane.
@@ -82,10 +88,11 @@ TEST(CellCoverage, SumsToTheSphereVolume) {
   }
 }
 
-// The vectorised list form gives the scalar numbers, and the coverage of a
-// cell moves smoothly as the sphere moves (no staircase: the sphere moved by
-// 0.01 dx changes no cell's coverage by more than about 0.01 * sqrt(3)).
-TEST(CellCoverage, ListFormAndSmallMovesAgree) {
+// The branch-free form (the one the step evaluates, in vector loops) gives
+// the scalar numbers, and the coverage of a cell moves smoothly as the sphere
+// moves (no staircase: the sphere moved by 0.01 dx changes no cell's
+// coverage by more than about 0.01 * sqrt(3)).
+TEST(CellCoverage, BranchFreeFormAndSmallMovesAgree) {
   const double a = 5.7;
   std::vector<float> rx, ry, rz;
   for (int i = -8; i <= 8; ++i)
@@ -95,9 +102,11 @@ TEST(CellCoverage, ListFormAndSmallMovesAgree) {
         ry.push_back(static_cast<float>(j + 0.11));
         rz.push_back(static_cast<float>(k - 0.47));
       }
+  const partially_saturated::SphereCoverage coverage(a);
   std::vector<float> eps(rx.size());
-  partially_saturated::list_coverage(static_cast<int>(rx.size()), rx.data(), ry.data(), rz.data(),
-                                     a, eps.data());
+  const int n = static_cast<int>(rx.size());
+#pragma omp simd
+  for (int q = 0; q < n; ++q) eps[q] = coverage(rx[q], ry[q], rz[q]);
   double jump = 0;
   for (std::size_t q = 0; q < rx.size(); ++q) {
     const double e = cell_coverage(rx[q], ry[q], rz[q], a);
@@ -107,6 +116,40 @@ TEST(CellCoverage, ListFormAndSmallMovesAgree) {
   EXPECT_LT(jump, 0.02);
   EXPECT_GT(jump, 0.001);  // the moved sphere did change covered cells
 }
+
+// Covers every cell of a lattice alike (coverage eps, solid velocity u_s,
+// every row covered) and keeps the density and momentum each cell's
+// collision saw, in lattice order.
+template <class Real>
+class UniformCoverage final : public lattice::SolidCoverage<Real> {
+ public:
+  UniformCoverage(lattice::Extent e, double eps, std::array<double, 3> us)
+      : velocity(us), density(static_cast<std::size_t>(e.cells())), eps_(eps) {
+    for (auto& m : momentum) m.resize(density.size());
+  }
+  std::array<double, 3> velocity;
+  std::vector<double> density;
+  std::array<std::vector<double>, 3> momentum;
+
+  void begin_step(int) override {}
+  bool cover(lattice::CoveredRow<Real>& row) override {
+    for (int x = 0; x < row.nx; ++x) {
+      row.coverage[x] = static_cast<Real>(eps_);
+      for (int d = 0; d < 3; ++d) row.solid_velocity[d][x] = static_cast<Real>(eps_ * velocity[d]);
+    }
+    return true;
+  }
+  void exchange(const lattice::CoveredRow<Real>& row) override {
+    const std::size_t at = static_cast<std::size_t>(row.row) * row.nx;
+    for (int x = 0; x < row.nx; ++x) {
+      density[at + x] = row.density[x];
+      for (int d = 0; d < 3; ++d) momentum[d][at + x] = row.momentum[d][x];
+    }
+  }
+
+ private:
+  double eps_;
+};
 
 // One step of a lattice whose every cell is covered: a fully covered cell
 // leaves its step with the solid's velocity for the next collision, whatever
@@ -122,15 +165,10 @@ TEST(PartiallySaturatedCollision, CoveredCellsConserveMassAndExchangeTheStatedMo
       return lattice::Macroscopic{1.0 + 0.01 * std::sin(x + 2 * y + 3 * z),
                                   {0.02 * std::cos(x), -0.01, 0.005 * y}};
     });
-    const double us[3] = {0.012, -0.004, 0.007};
-    auto view = fluid.solid_coverage();
-    for (long c = 0; c < e.cells(); ++c) {
-      view.coverage[c] = covered;
-      for (int d = 0; d < 3; ++d) view.solid_velocity[d][c] = covered * us[d];
-    }
-    for (long r = 0; r < e.rows(); ++r) view.chunk_row(r)[0] = 1;  // the row's one chunk
+    UniformCoverage<double> cover(e, covered, {0.012, -0.004, 0.007});
     const double mass = fluid.total_mass();
     const lattice::Vector3 p0 = fluid.total_momentum();
+    fluid.set_solid_coverage(&cover);
     fluid.step();
     EXPECT_NEAR(fluid.total_mass(), mass, 1e-12 * mass);
     // the momentum the step added beyond the body force, from the density and
@@ -139,7 +177,8 @@ TEST(PartiallySaturatedCollision, CoveredCellsConserveMassAndExchangeTheStatedMo
     double exchange[3] = {0, 0, 0};
     for (long c = 0; c < e.cells(); ++c)
       for (int d = 0; d < 3; ++d)
-        exchange[d] += covered * (view.density[c] * us[d] - view.momentum[d][c] - f[d]);
+        exchange[d] +=
+            covered * (cover.density[c] * cover.velocity[d] - cover.momentum[d][c] - f[d]);
     const lattice::Vector3 p1 = fluid.total_momentum();
     const double cells = static_cast<double>(e.cells());
     // total_momentum() adds half of the body force to each cell before and after alike
@@ -160,13 +199,9 @@ TEST(PartiallySaturatedCollision, FullyCoveredCellsTakeTheSolidVelocity) {
     return lattice::Macroscopic{1.003, {0.02, -0.01, 0.015}};
   });
   const double us[3] = {-0.011, 0.006, 0.002};
-  auto view = fluid.solid_coverage();
-  for (long c = 0; c < e.cells(); ++c) {
-    view.coverage[c] = 1.0;
-    for (int d = 0; d < 3; ++d) view.solid_velocity[d][c] = us[d];
-  }
-  for (long r = 0; r < e.rows(); ++r) view.chunk_row(r)[0] = 1;
+  UniformCoverage<double> cover(e, 1.0, {us[0], us[1], us[2]});
   for (int step = 0; step < 3; ++step) {
+    fluid.set_solid_coverage(&cover);  // for one step
     fluid.step();
     for (int x = 0; x < e.nx; ++x) {
       const lattice::Macroscopic m = fluid.macroscopic(x, 1, 0);
@@ -178,9 +213,9 @@ TEST(PartiallySaturatedCollision, FullyCoveredCellsTakeTheSolidVelocity) {
   }
 }
 
-// A chunk marked covered whose cells hold no solid collides exactly as the
-// plain liquid (to round-off: the blend is evaluated with B = 0).
-TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredChunkAreLiquid) {
+// Cells of a covered row that hold no solid collide exactly as the plain
+// liquid (to round-off: the blend is evaluated with B = 0).
+TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredRowAreLiquid) {
   const lattice::Extent e{20, 3, 3};
   auto init = [](int x, int y, int z) {
     return lattice::Macroscopic{1.0 + 0.01 * std::cos(x + y - z),
@@ -191,15 +226,143 @@ TEST(PartiallySaturatedCollision, UncoveredCellsOfACoveredChunkAreLiquid) {
     f->set_body_force({1e-5, 0, 0});
     f->initialise_equilibrium(init);
   }
-  auto view = blended.solid_coverage();
-  for (long r = 0; r < e.rows(); ++r) view.chunk_row(r)[0] = 3;  // both chunks of every row
-  for (int s = 0; s < 7; ++s) {                                  // odd and even steps
+  UniformCoverage<double> cover(e, 0.0, {0, 0, 0});  // covers every row, with eps = 0
+  for (int s = 0; s < 7; ++s) {                      // odd and even steps
     plain.step();
+    blended.set_solid_coverage(&cover);
     blended.step();
   }
   for (int x = 0; x < e.nx; ++x)
     for (int i = 0; i < 19; ++i)
       EXPECT_NEAR(blended.population(i, x, 1, 2), plain.population(i, x, 1, 2), 1e-15);
+}
+
+// Five spheres in a small periodic box, moving and spinning, on a lattice
+// with a flow and a per-cell force field: two touching (they share the cells
+// at their contact), two overlapping (summed coverage above 1, where
+// B = min(1, eps) saturates), one across the box's corner (its rows wrap in
+// x, y and z).
+template <class Real>
+struct FiveSpheres {
+  static constexpr double kInputRadius = 3.6;
+  lattice::Extent e{40, 30, 26};
+  spheres::SphereSet s;
+  lattice::FluidLattice<Real> fused{e, {0.05, 0.25}}, reference{e, {0.05, 0.25}};
+
+  FiveSpheres() {
+    const double a = kInputRadius;
+    s.radius = a;
+    s.density_ratio = 4;
+    s.resize(6);
+    s.position = {{20.3, 15.2, 13.1}, {20.3 + 2 * a, 15.2, 13.1},
+                  {10.5, 22.0, 7.0},  {10.5 + 2 * a - 0.5, 22.3, 7.2},
+                  {0.7, 0.4, 25.6},   {33.2, 6.1, 19.4}};
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const double q = static_cast<double>(k);
+      s.velocity[k] = Vec3(0.01 * std::cos(q), -0.004 * q, 0.003 - 0.002 * q);
+      s.angular_velocity[k] = Vec3(0.001 * q, -0.0015, 0.0007 * std::sin(q));
+    }
+    for (auto* f : {&fused, &reference}) {
+      f->set_body_force({2e-5, -1e-5, 5e-6});
+      auto field = f->force_field();
+      for (long c = 0; c < e.cells(); ++c)
+        for (int d = 0; d < 3; ++d)
+          field.component[d][c] = static_cast<Real>(1e-6 * std::sin(0.7 * c + d));
+      f->initialise_equilibrium([](int x, int y, int z) {
+        return lattice::Macroscopic{1.0 + 0.01 * std::sin(0.3 * x + 0.2 * y - 0.1 * z),
+                                    {0.02 * std::cos(0.2 * y), -0.01 * std::sin(0.15 * x), 0.005}};
+      });
+    }
+  }
+  void move() {
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      s.position[k] += s.velocity[k];
+      const double length[3] = {double(e.nx), double(e.ny), double(e.nz)};
+      for (int d = 0; d < 3; ++d)
+        s.position[k][d] -= length[d] * std::floor(s.position[k][d] / length[d]);
+    }
+  }
+};
+
+// The largest difference over the spheres relative to the largest value.
+double relative_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double diff = 0, scale = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, (a[k] - b[k]).norm());
+    scale = std::max(scale, b[k].norm());
+  }
+  return scale > 0 ? diff / scale : 1.0;
+}
+
+// The fused step (coverage, blended collision and the loads' sums in one
+// pass over each row) gives each sphere the force, torque and inside
+// momenta of the reference (the lattice-sized arrays, gathered sphere by
+// sphere afterwards) to round-off, step after step, odd and even.
+template <class Real>
+void expect_fused_matches_reference(double tolerance) {
+  FiveSpheres<Real> scene;
+  const double a = scene.kInputRadius;
+  // the touching pair does share cells
+  int shared = 0;
+  for (int i = 20; i < 30; ++i)
+    for (int j = 10; j < 20; ++j)
+      for (int k = 8; k < 18; ++k)
+        shared += partially_saturated::cell_coverage(i - 20.3, j - 15.2, k - 13.1, a) > 0 &&
+                  partially_saturated::cell_coverage(i - 20.3 - 2 * a, j - 15.2, k - 13.1, a) > 0;
+  EXPECT_GT(shared, 4);
+  partially_saturated::PartiallySaturatedCells<Real> fused(a);
+  testing_support::ReferencePartiallySaturatedCells<Real> reference(a);
+  for (int step = 0; step < 4; ++step) {
+    fused.apply(scene.fused, scene.s);
+    scene.fused.step();
+    fused.after_liquid_step(scene.fused, scene.s);
+    reference.apply(scene.reference, scene.s);
+    scene.reference.step();
+    reference.after_liquid_step(scene.reference);
+    EXPECT_LT(relative_difference(fused.force(), reference.force), tolerance) << "step " << step;
+    EXPECT_LT(relative_difference(fused.torque(), reference.torque), tolerance) << "step " << step;
+    EXPECT_LT(relative_difference(fused.internal_momentum(), reference.momentum), tolerance);
+    EXPECT_LT(relative_difference(fused.internal_angular_momentum(), reference.angular), tolerance);
+    // not trivially: the liquid pushes every sphere, and holds liquid inside it
+    for (std::size_t k = 0; k < scene.s.size(); ++k) {
+      EXPECT_GT(reference.force[k].norm(), 1e-4);
+      EXPECT_GT(reference.momentum[k].norm(), 0.1);
+    }
+    scene.move();
+  }
+}
+
+TEST(PartiallySaturatedCells, FusedStepMatchesTheReference) {
+  expect_fused_matches_reference<double>(1e-12);
+  expect_fused_matches_reference<float>(1e-5);
+}
+
+// Each run of cells keeps its own sums and each sphere adds them in a fixed
+// order: the loads and the liquid come out bit for bit the same on one
+// thread and on three.
+TEST(PartiallySaturatedCells, ResultsDoNotDependOnTheThreadCount) {
+  const int threads = omp_get_max_threads();
+  std::vector<Vec3> loads[2];
+  double population[2] = {0, 0};
+  for (int run = 0; run < 2; ++run) {
+    omp_set_num_threads(run == 0 ? 1 : 3);
+    FiveSpheres<float> scene;
+    partially_saturated::PartiallySaturatedCells<float> psm(scene.kInputRadius);
+    for (int step = 0; step < 3; ++step) {
+      psm.apply(scene.fused, scene.s);
+      scene.fused.step();
+      psm.after_liquid_step(scene.fused, scene.s);
+      scene.move();
+    }
+    for (const auto* v :
+         {&psm.force(), &psm.torque(), &psm.internal_momentum(), &psm.internal_angular_momentum()})
+      loads[run].insert(loads[run].end(), v->begin(), v->end());
+    population[run] = scene.fused.population(7, 21, 15, 13) + scene.fused.population(3, 0, 0, 25);
+  }
+  omp_set_num_threads(threads);
+  ASSERT_EQ(loads[0].size(), loads[1].size());
+  for (std::size_t q = 0; q < loads[0].size(); ++q) EXPECT_EQ(loads[0][q], loads[1][q]) << q;
+  EXPECT_EQ(population[0], population[1]);
 }
 
 // The control law: e = U - v; F += rho (G e + P (e - e_previous)).
