@@ -22,7 +22,10 @@
 // the fluctuation at the crossing frequency (the largest component of U over
 // dx) and its harmonics. --held 1 also runs the sphere held in the liquid
 // moving past it (at a node-aligned and a mid-cell place, averaged) and
-// prints that drag and dragged / held: 1 for a Galilean-invariant scheme.
+// prints that drag and dragged / held: 1 for a Galilean-invariant scheme, and
+// the held sphere's own fluctuation in a steady flow (rms / mean, and the
+// strongest spectral line: its frequency in cycles per step and amplitude /
+// mean): what the scheme itself rings with when nothing crosses the grid.
 // --series writes the dragged force per step to PREFIX<option>.txt.
 #include <omp.h>
 
@@ -82,7 +85,8 @@ int main(int argc, char** argv) {
       "# one sphere dragged at U = %.4g (Re %g) through %d x %d x %d, a = %g, nu = %g, %ld steps\n",
       U, re, L, W, W, a, nu, steps);
   std::printf("# %-58s %9s %10s %12s %12s%s\n", "option", "a_g", "F/(6pi nu a U)", "rms/mean",
-              "crossing rms", held ? "       held  dragged/held" : "");
+              "crossing rms",
+              held ? "       held  dragged/held held rms/mean  peak f/step  peak a/mean" : "");
   for (const std::string& text : bench::split(options, ',')) {
     const auto scheme = bench::parse_option(text);
     if (!scheme) {
@@ -162,9 +166,29 @@ int main(int argc, char** argv) {
     if (held) {
       // the same sphere held in the liquid moving past it, at a node-aligned and
       // a mid-cell place (the dragged sphere averages over the cells it crosses)
-      const double still = 0.5 * (second_half_mean(drag_series(true, 0.0)) +
-                                  second_half_mean(drag_series(true, 0.5)));
+      const std::vector<double> node = drag_series(true, 0.0);
+      const double still =
+          0.5 * (second_half_mean(node) + second_half_mean(drag_series(true, 0.5)));
       std::printf(" %10.4f %10.4f", still / unit, mean / still);
+      // what the held (node-aligned) sphere's drag still does over the second
+      // half, where the flow past it is steady: its rms fluctuation and the
+      // strongest line of its spectrum (frequency in cycles per step, scanned
+      // from 1/m to 1/2 in steps of 1/m; amplitude relative to the mean)
+      const double node_mean = second_half_mean(node);
+      double node_var = 0;
+      for (std::size_t k = h; k < node.size(); ++k)
+        node_var += (node[k] - node_mean) * (node[k] - node_mean);
+      double peak_f = 0, peak_a = 0;
+      for (std::size_t j = 1; j <= m / 2; ++j) {
+        const double fr = static_cast<double>(j) / static_cast<double>(m);
+        std::complex<double> c = 0;
+        for (std::size_t k = h; k < node.size(); ++k)
+          c += (node[k] - node_mean) * std::polar(1.0, -2 * M_PI * fr * static_cast<double>(k - h));
+        const double amplitude = 2 * std::abs(c) / static_cast<double>(m);
+        if (amplitude > peak_a) peak_a = amplitude, peak_f = fr;
+      }
+      std::printf(" %12.3e %10.4f %12.3e", std::sqrt(node_var / m) / std::abs(node_mean), peak_f,
+                  peak_a / std::abs(node_mean));
     }
     std::printf("\n");
     std::fflush(stdout);
