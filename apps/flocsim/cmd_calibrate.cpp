@@ -197,19 +197,12 @@ void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
   if (given("--sweeps") && scheme.control())
     throw input::InputError("--sweeps: control forcing makes one correction per step");
   if (scheme.control() && scheme.marker_spacing < coupling::kSmallestControlMarkerSpacing)
-    throw input::InputError(
-        "--marker-spacing " + number_text(scheme.marker_spacing) + " with --forcing control: " +
-        "must be >= " + number_text(coupling::kSmallestControlMarkerSpacing) +
-        " (closer markers make a moving sphere feel 15-22 % less drag than a held one; "
-        "docs/coupling.md)");
+    throw input::InputError("--marker-spacing " + number_text(scheme.marker_spacing) +
+                            " with --forcing control: " + coupling::dense_control_markers_why());
   if (scheme.control() && !coupling::stable_gains(scheme.gains))
     throw input::InputError("--gains " + number_text(scheme.gains.integral) + " " +
-                            number_text(scheme.gains.proportional) +
-                            ": outside the region where control forcing was measured stable: "
-                            "integral >= " +
-                            number_text(coupling::kSmallestIntegralGain) +
-                            ", proportional >= 0, integral + 2 proportional <= " +
-                            number_text(coupling::kLargestPeriodTwoGain) + " (docs/coupling.md)");
+                            number_text(scheme.gains.proportional) + ": " +
+                            coupling::stable_gains_region());
   for (std::size_t k = 1; k < o.gaps.size(); ++k)
     if (!(o.gaps[k] > o.gaps[k - 1]))
       throw input::InputError("--gaps: must increase (the last gives the box offset), got " +

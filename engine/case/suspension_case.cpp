@@ -99,10 +99,7 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
     if (scheme.marker_spacing < coupling::kSmallestControlMarkerSpacing)
       throw InputError(
           "numerics.immersed_boundary.marker_spacing = " + format_value(scheme.marker_spacing) +
-          " with control forcing: must be >= " +
-          format_value(coupling::kSmallestControlMarkerSpacing) +
-          " (with markers closer than the lattice spacing a sphere moving through the liquid "
-          "feels 0.78-0.85 of the drag it feels held, at 1 dx 0.995-1.0005; docs/coupling.md)");
+          " with control forcing: " + coupling::dense_control_markers_why());
     if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
       throw InputError(
           "numerics.immersed_boundary.sweeps: control forcing makes one correction "
@@ -116,14 +113,10 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
       scheme.gains.proportional =
           g.number("proportional", {.at_least = 0, .at_most = 100}, scheme.gains.proportional);
       if (!coupling::stable_gains(scheme.gains))
-        throw InputError(
-            "numerics.immersed_boundary.gains = {integral " + format_value(scheme.gains.integral) +
-            ", proportional " + format_value(scheme.gains.proportional) +
-            "}: outside the region where control forcing was measured stable: integral >= " +
-            format_value(coupling::kSmallestIntegralGain) +
-            ", proportional >= 0, integral + 2 proportional <= " +
-            format_value(coupling::kLargestPeriodTwoGain) +
-            " (a settling sphere shakes itself apart in a period-2 mode at 4; docs/coupling.md)");
+        throw InputError("numerics.immersed_boundary.gains = {integral " +
+                         format_value(scheme.gains.integral) + ", proportional " +
+                         format_value(scheme.gains.proportional) +
+                         "}: " + coupling::stable_gains_region());
       g.finish();
     }
   } else {

@@ -120,6 +120,18 @@ inline bool stable_gains(const ControlGains& g) {
   return g.integral >= kSmallestIntegralGain && g.proportional >= 0 &&
          g.integral + 2 * g.proportional <= kLargestPeriodTwoGain * (1 + 1e-12);
 }
+// Why gains outside stable_gains are refused, for every message that refuses
+// them (the case reader, flocsim calibrate): the region and what happens
+// beyond it.
+inline std::string stable_gains_region() {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "outside the region where control forcing was measured stable: integral >= %g, "
+                "proportional >= 0, integral + 2 proportional <= %g (a settling sphere shakes "
+                "itself apart in a period-2 mode at 4; docs/coupling.md)",
+                kSmallestIntegralGain, kLargestPeriodTwoGain);
+  return text;
+}
 
 struct Scheme {
   // Immersed boundary only:
@@ -189,6 +201,16 @@ inline constexpr Scheme kOneSweepScheme{1.0, 1, Kernel::roma3};
 inline constexpr Scheme kControlScheme{1.0, 1, Kernel::roma3, Forcing::control};
 // Control forcing's densest markers (dx): see kControlScheme.
 inline constexpr double kSmallestControlMarkerSpacing = 1.0;
+// Why closer markers are refused, for every message that refuses them.
+inline std::string dense_control_markers_why() {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "must be >= %g (with markers closer than the lattice spacing a sphere moving "
+                "through the liquid feels 0.78-0.85 of the drag it feels held, at 1 dx "
+                "0.995-1.0005; docs/coupling.md)",
+                kSmallestControlMarkerSpacing);
+  return text;
+}
 
 // Partially saturated cells: no markers.
 inline constexpr Scheme kPartiallySaturatedScheme{.method = Method::partially_saturated};
