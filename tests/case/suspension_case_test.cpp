@@ -721,7 +721,7 @@ TEST(SuspensionCaseCoupling, ControlForcingAndPartiallySaturatedCellsFromTheTabl
   EXPECT_THAT(refusal(control), AllOf(HasSubstr("input_radius"), HasSubstr("1.5 dx")));
   json uncalibrated = control;
   uncalibrated["numerics"].erase("input_radius");
-  uncalibrated["numerics"]["a_over_dx"] = 8;  // control forcing is calibrated at a = 4 only
+  uncalibrated["numerics"]["a_over_dx"] = 8;  // control forcing is calibrated at a = 4 and 6 only
   EXPECT_THAT(refusal(uncalibrated), AllOf(HasSubstr("not calibrated at numerics.a_over_dx = 8"),
                                            HasSubstr("--forcing control --marker-spacing 1")));
 

@@ -67,5 +67,16 @@ TEST(ClosePairSlow, OneSweepOptionNearBrennerAtA6) {
   expect_total_near_brenner(6, 0.03, kFewGaps, 14, coupling::kOneSweepScheme, "standard");
 }
 
+// Control forcing (markers 1 dx apart, gains 2, 0), calibrated at nu = 0.02 in
+// a 16a box at a = 4 and 6: measured again in a 20a box (a = 4) and a 14a box
+// (a = 6), approaching and separating.
+TEST(ClosePairSlow, ControlForcingNearBrennerAtA4) {
+  expect_total_near_brenner(4, 0.02, kFewGaps, 20, coupling::kControlScheme, "standard");
+}
+
+TEST(ClosePairSlow, ControlForcingNearBrennerAtA6) {
+  expect_total_near_brenner(6, 0.02, kFewGaps, 14, coupling::kControlScheme, "standard");
+}
+
 }  // namespace
 }  // namespace flocsim::lubrication
