@@ -1,7 +1,8 @@
 // The close-pair calibration at the paper's viscosities, at a = 6 and for the
 // one-sweep immersed-boundary option (slow: low viscosities take long to reach
 // a steady flow). Each measures again in a box the calibration did not use
-// (20a at a = 4, where it used 16a; 14a at a = 6 and 8, where it used 12a) and at
+// (20a at a = 4, where it used 16a; 14a at a = 6 and 8, where it used 12a, 16a
+// for control forcing) and at
 // gaps and viscosities between the calibrated ones. docs/contacts.md.
 #include "tests/lubrication/close_pair_total.hpp"
 

@@ -41,9 +41,9 @@ inline RadialLubrication lubrication_of_case(double a, double nu, const coupling
 
 // Every gap within 15 % of the exact resistance, approaching and separating,
 // in a box other than the calibration's (box_over_a; the calibration used 16a
-// at a = 4 and 12a at a = 6 and 8), scheme `scheme`. The gaps are measured in one
-// pass, each from the flow of the one before, and the box offset of this box
-// is read at s = 0.5a like the calibration's.
+// at a = 4 and 12a at a = 6 and 8, 16a for control forcing at a = 6), scheme `scheme`. The gaps are
+// measured in one pass, each from the flow of the one before, and the box offset of this box is
+// read at s = 0.5a like the calibration's.
 inline void expect_total_near_brenner(double a, double nu, const std::vector<double>& gaps,
                                       double box_over_a = 20, const coupling::Scheme& scheme = {},
                                       const std::string& fidelity = "paper") {
