@@ -207,6 +207,17 @@ void check_before_work(const CalibrateOptions& o, const CLI::App& cmd) {
     if (!(o.gaps[k] > o.gaps[k - 1]))
       throw input::InputError("--gaps: must increase (the last gives the box offset), got " +
                               number_text(o.gaps[k - 1]) + " then " + number_text(o.gaps[k]));
+  // The last gap's measured-minus-exact is taken as the box's own share at
+  // every gap, which holds only where the lattice's close-pair share has died
+  // out: at 0.1a it still holds most of it (a = 6, control forcing: +2.93
+  // against +0.20 at 0.5a).
+  const double offset_gap = calibration::default_pair_gaps().back();
+  if (!o.gaps.empty() && o.gaps.back() < offset_gap)
+    throw input::InputError(
+        "--gaps: the last gap, " + number_text(o.gaps.back()) +
+        ", gives the box offset (measured minus exact resistance there), which is the box's own "
+        "share only where the lattice's close-pair share has died out: the last gap must be >= " +
+        number_text(offset_gap) + " (add " + number_text(offset_gap) + ")");
   // a sphere must not reach its own periodic image: the immersed boundary
   // needs L > 2 a_g + 3 (its kernel), partially saturated cells
   // L > 2 (a_g + sqrt(3)/2); checked here for the first pass's a_g = a - 0.3
@@ -284,7 +295,7 @@ const bool registered = register_command(
                     "calibration)");
        cmd.add_flag("--separating", o->separating, "with --close-pairs: spheres moving apart");
        cmd.add_option("--gaps", o->gaps,
-                      "with --close-pairs: gaps s/a, increasing; the last "
+                      "with --close-pairs: gaps s/a, increasing; the last, >= 0.5, "
                       "gives the box offset (default 0.005 ... 0.5)")
            ->check(finite_number(1e-4, 2.0));
        cmd.add_option("--pair-box", o->pair_box_over_a,

@@ -60,6 +60,20 @@ TEST_F(Calibrate, RefusesNonFiniteNumbersNamingTheOption) {
   }
 }
 
+// The box offset is read at the last gap (measured minus exact there). A gap
+// list stopping at 0.1a made a table whose offset held the lattice's own
+// close-pair share (+2.93 instead of +0.20 at a = 6, control forcing) and
+// so a wrong correction at every gap, without a word.
+TEST_F(Calibrate, RefusesCloseGapsThatEndBeforeTheBoxOffsetGap) {
+  const std::string table = (dir_ / "t.json").string();
+  t::Output o;
+  const double s = seconds_of([&] {
+    o = t::run(flocsim({"calibrate", "--table", table, "--radius", "4", "--close-pairs", "--gaps",
+                        "0.005", "0.01", "0.1"}));
+  });
+  expect_refused_up_front(o, {"--gaps", "0.1", "box offset", "0.5"}, table, s);
+}
+
 // Options of a scheme other than the chosen one were ignored (a radius entry
 // written for a scheme the user did not mean); unstable gains and control
 // forcing's dense markers ran for minutes before the lattice said why.
