@@ -73,7 +73,7 @@ TEST(SuspensionCase, LatticeUnitsByHand) {
 // Each preset's settling velocity when the case gives neither U_inf nor the
 // viscosity (docs/accuracy-cost.md, "The lattice Mach number"): draft 0.07,
 // the largest measured within 1.5 % in F; standard 0.04, where the a = 6
-// close-pair tables still reach every Re_inf of the paper's grid; paper 0.02,
+// close-pair tables reached every Re_inf of the paper's grid when it was chosen; paper 0.02,
 // inside the paper's own range. At Re_inf 12, nu = 2 a U_inf / 12 and a/U_inf
 // steps: draft 2 * 4 * 0.07 / 12 = 0.04667 and 57.1; standard 0.04 and 150;
 // paper 0.02 and 300.
@@ -429,13 +429,13 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   EXPECT_DOUBLE_EQ(pairs.viscosity_gap(6, 0.04 / 6, coupling::kOneSweepScheme), 1.0);
   for (const auto& w : fast.warnings)
     EXPECT_EQ(w.find("close-pair calibration"), std::string::npos) << w;
-  // nu = 0.1 at a = 6: both schemes' highest entry (0.04) is a factor 2.5 away,
+  // nu = 0.2 at a = 6: both schemes' highest entry (0.08) is a factor 2.5 away,
   // so the faster one runs, with a warning naming the gap and its command
   const SuspensionCase neither = parse_suspension_case({{"scene", "suspension"},
                                                         {"fidelity", "standard"},
                                                         {"phi", 0.2},
                                                         {"Re_inf", 3},
-                                                        {"numerics", {{"viscosity", 0.1}}}});
+                                                        {"numerics", {{"viscosity", 0.2}}}});
   EXPECT_EQ(neither.numerics.coupling, coupling::kOneSweepScheme);
   bool gap_named = false;
   for (const auto& w : neither.warnings)
@@ -459,16 +459,16 @@ TEST(SuspensionCase, CalibratedClosePairsByDefault) {
   EXPECT_NO_THROW(parse_suspension_case(
       {{"scene", "fixed-array"}, {"phi", 0.2}, {"numerics", {{"a_over_dx", 8}}}}));
   // far from the calibrated viscosities: accepted with a warning naming the gap
-  // (a = 6 entries at nu = 0.01, 0.02 and 0.04; nu = 0.1 is 2.5x above)
+  // (a = 6 entries at nu = 0.005-0.08; nu = 0.2 is 2.5x above)
   const SuspensionCase far = parse_suspension_case({{"scene", "suspension"},
                                                     {"fidelity", "paper"},
                                                     {"phi", 0.2},
                                                     {"Re_inf", 3},
-                                                    {"numerics", {{"viscosity", 0.1}}}});
+                                                    {"numerics", {{"viscosity", 0.2}}}});
   bool warned = false;
   for (const auto& w : far.warnings)
     warned =
-        warned || w.find("close-pair calibration nearest to viscosity = 0.1") != std::string::npos;
+        warned || w.find("close-pair calibration nearest to viscosity = 0.2") != std::string::npos;
   EXPECT_TRUE(warned);
 }
 

@@ -77,7 +77,7 @@ TEST(PaperGrid, PresetDefaultsStayNearTheirCalibrations) {
   // Each preset's U_inf is chosen so that nu = 2 a U_inf / Re_inf stays within
   // a factor 2 of a hydrodynamic-radius and a close-pair calibration of the
   // option it runs, at every point of the grid it accepts (the a = 6
-  // close-pair tables stop at nu = 0.04: standard's U_inf 0.04 puts Re_inf 6
+  // close-pair tables reach nu = 0.08: standard's U_inf 0.04 puts Re_inf 6
   // on nu = 0.08, paper's 0.02 on 0.04; draft's 0.07 puts it on 0.093, where
   // the paper's method is calibrated at a = 4 and runs). No point may run on
   // a calibration made further away, which the case reports as a warning.
