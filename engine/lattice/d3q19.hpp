@@ -5,6 +5,8 @@
 // -time collision works on exactly these pairs.
 #include <array>
 
+#include "engine/lattice/kernel_body.hpp"
+
 namespace flocsim::d3q19 {
 
 inline constexpr int kQ = 19;
@@ -22,7 +24,7 @@ inline constexpr double kWeightAxis = 1.0 / 18.0;
 inline constexpr double kWeightDiagonal = 1.0 / 36.0;
 inline constexpr double kSoundSpeedSquared = 1.0 / 3.0;
 
-constexpr int opposite(int i) {
+FLOCSIM_HD constexpr int opposite(int i) {
   return i == 0 ? 0 : (i % 2 == 1 ? i + 1 : i - 1);
 }
 
@@ -36,5 +38,36 @@ inline constexpr std::array<double, kQ> w = [] {
   for (int i = 0; i < kQ; ++i) out[i] = weight(i);
   return out;
 }();
+
+// The same velocities and weights as functions, for kernel bodies
+// (kernel_body.hpp): device code cannot read the host arrays above, while a
+// constant argument (the unrolled loops' i) folds to a literal on both sides.
+FLOCSIM_HD constexpr int velocity_x(int i) {
+  constexpr int t[kQ] = {0, 1, -1, 0, 0, 0, 0, 1, -1, 1, -1, 1, -1, 1, -1, 0, 0, 0, 0};
+  return t[i];
+}
+FLOCSIM_HD constexpr int velocity_y(int i) {
+  constexpr int t[kQ] = {0, 0, 0, 1, -1, 0, 0, 1, -1, -1, 1, 0, 0, 0, 0, 1, -1, 1, -1};
+  return t[i];
+}
+FLOCSIM_HD constexpr int velocity_z(int i) {
+  constexpr int t[kQ] = {0, 0, 0, 0, 0, 1, -1, 0, 0, 0, 0, 1, -1, -1, 1, 1, -1, -1, 1};
+  return t[i];
+}
+// Rest 1/3, the six axis links 1/18, the twelve face diagonals 1/36.
+FLOCSIM_HD constexpr double weight_of(int i) {
+  return i == 0 ? kWeightRest : (i <= 6 ? kWeightAxis : kWeightDiagonal);
+}
+
+namespace detail {
+constexpr bool functions_match_arrays() {
+  for (int i = 0; i < kQ; ++i)
+    if (velocity_x(i) != cx[i] || velocity_y(i) != cy[i] || velocity_z(i) != cz[i] ||
+        weight_of(i) != w[i])
+      return false;
+  return true;
+}
+static_assert(functions_match_arrays(), "D3Q19 velocity functions must match the arrays");
+}  // namespace detail
 
 }  // namespace flocsim::d3q19

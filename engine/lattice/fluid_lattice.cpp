@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/partially_saturated_collision.hpp"
 #include "engine/lattice/trt_collision.hpp"
 
@@ -48,24 +49,6 @@ void current_population_rows(const Real* base, long stride, int nx, int ny, int 
       p[i] = base + opposite(i) * stride + up - cx[i];
     }
   }
-}
-
-// Density and velocity of one cell from its 19 deviations, with half of the
-// force density (hx, hy, hz) = F/2 added to the momentum (Guo's shift).
-template <class T>
-FLOCSIM_ALWAYS_INLINE void cell_moments(const T (&f)[kQ], T hx, T hy, T hz, T& rho, T& ux, T& uy,
-                                        T& uz) {
-  T drho = 0;
-#pragma GCC unroll 19
-  for (int i = 0; i < kQ; ++i) drho += f[i];
-  const T jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
-  const T jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];
-  const T jz = f[5] - f[6] + f[11] - f[12] - f[13] + f[14] + f[15] - f[16] - f[17] + f[18];
-  rho = T(1) + drho;
-  const T inv = T(1) / rho;
-  ux = (jx + hx) * inv;
-  uy = (jy + hy) * inv;
-  uz = (jz + hz) * inv;
 }
 
 }  // namespace
@@ -229,7 +212,7 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
   const bool even = time_step_ % 2 == 0;
   const Real* p[kQ];
   current_population_rows(populations_.get(), stride_, nx, extent_.ny, extent_.nz, y, z, even, p);
-  const double hx = 0.5 * body_force_.x, hy = 0.5 * body_force_.y, hz = 0.5 * body_force_.z;
+  const double bx = body_force_.x, by = body_force_.y, bz = body_force_.z;
   for (int k = 0; k < count; ++k) {
     const int x = x0 + k;
     if (!even && (x == 0 || x == nx - 1)) {  // the end cells' upstream wraps in x
@@ -242,7 +225,7 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
     }
     double f[kQ];
     for (int i = 0; i < kQ; ++i) f[i] = p[i][x];
-    cell_moments(f, hx, hy, hz, density[k], ux[k], uy[k], uz[k]);
+    cell_moments(f, bx, by, bz, density[k], ux[k], uy[k], uz[k]);
   }
 }
 
@@ -253,9 +236,9 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
   const bool even = time_step_ % 2 == 0;
   const Real* p[kQ];
   current_population_rows(populations_.get(), stride_, nx, extent_.ny, extent_.nz, y, z, even, p);
-  const Real hx = static_cast<Real>(0.5 * body_force_.x);
-  const Real hy = static_cast<Real>(0.5 * body_force_.y);
-  const Real hz = static_cast<Real>(0.5 * body_force_.z);
+  const Real bx = static_cast<Real>(body_force_.x);
+  const Real by = static_cast<Real>(body_force_.y);
+  const Real bz = static_cast<Real>(body_force_.z);
   int k_begin = 0, k_end = count;
   // At an odd step the upstream of the end cells wraps in x: slot x - c_x is
   // read through p[i][x] as p[i][x - c_x + c_x], so wrap x - c_x first.
@@ -267,7 +250,7 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
       up = up < 0 ? up + nx : (up >= nx ? up - nx : up);
       f[i] = p[i][up + cx[i]];
     }
-    cell_moments(f, hx, hy, hz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
+    cell_moments(f, bx, by, bz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
   };
   if (!even && count > 0 && x0 == 0) edge(k_begin++);
   if (!even && k_end > k_begin && x0 + count == nx) edge(--k_end);
@@ -276,7 +259,7 @@ void FluidLattice<Real>::macroscopic_row_without_force_field(int x0, int count, 
     Real f[kQ];
 #pragma GCC unroll 19
     for (int i = 0; i < kQ; ++i) f[i] = p[i][x0 + k];
-    cell_moments(f, hx, hy, hz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
+    cell_moments(f, bx, by, bz, rho_u[4 * k], rho_u[4 * k + 1], rho_u[4 * k + 2], rho_u[4 * k + 3]);
   }
 }
 

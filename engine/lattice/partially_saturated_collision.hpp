@@ -42,14 +42,14 @@ namespace flocsim::lattice {
 // the cell; eps the summed coverage; (Vx, Vy, Vz) = sum eps_k u_k. Returns
 // the density and the momentum density rho u the collision saw.
 template <class Real>
-FLOCSIM_ALWAYS_INLINE void collide_partially_saturated(Real (&f)[d3q19::kQ], Real Fx, Real Fy,
+FLOCSIM_KERNEL_BODY void collide_partially_saturated(Real (&f)[d3q19::kQ], Real Fx, Real Fy,
                                                        Real Fz, Real eps, Real Vx, Real Vy, Real Vz,
                                                        const CollisionConstants<Real>& k,
                                                        Real& rho_out, Real& jx_out, Real& jy_out,
                                                        Real& jz_out) {
   using namespace d3q19;
   Real drho = 0;
-#pragma GCC unroll 19
+FLOCSIM_UNROLL
   for (int i = 0; i < kQ; ++i) drho += f[i];
   const Real rho = Real(1) + drho;
   const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
@@ -87,12 +87,12 @@ FLOCSIM_ALWAYS_INLINE void collide_partially_saturated(Real (&f)[d3q19::kQ], Rea
   const Real M_F = Real(3) * (liquid * k.force_minus - Real(0.5) * om * B);
 
   f[0] += -op * f[0] + Real(kWeightRest) * K;
-#pragma GCC unroll 9
+FLOCSIM_UNROLL
   for (int i = 1; i < kQ; i += 2) {
-    const Real wi = Real(w[i]);
-    const Real cu = Real(cx[i]) * ux + Real(cy[i]) * uy + Real(cz[i]) * uz;
-    const Real cs = Real(cx[i]) * sx + Real(cy[i]) * sy + Real(cz[i]) * sz;
-    const Real cF = Real(cx[i]) * Fx + Real(cy[i]) * Fy + Real(cz[i]) * Fz;
+    const Real wi = Real(weight_of(i));
+    const Real cu = Real(velocity_x(i)) * ux + Real(velocity_y(i)) * uy + Real(velocity_z(i)) * uz;
+    const Real cs = Real(velocity_x(i)) * sx + Real(velocity_y(i)) * sy + Real(velocity_z(i)) * sz;
+    const Real cF = Real(velocity_x(i)) * Fx + Real(velocity_y(i)) * Fy + Real(velocity_z(i)) * Fz;
     const Real f_plus = Real(0.5) * (f[i] + f[i + 1]);
     const Real f_minus = Real(0.5) * (f[i] - f[i + 1]);
     const Real d_plus = -op * f_plus + wi * (K + (A_u * cu + A_F * cF) * cu + A_s * cs * cs);

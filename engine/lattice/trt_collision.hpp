@@ -2,19 +2,10 @@
 // The collision of one liquid cell: two-relaxation-time (TRT) with Guo et al.
 // (2002) forcing split into its symmetric and antisymmetric parts, each scaled
 // by (1 - omega/2) of its own relaxation rate (relaxation.hpp, fluid_lattice.hpp).
-// A per-cell function, apart from the loops that vectorise it over the rows
-// (fluid_lattice.cpp).
+// A kernel body (kernel_body.hpp): one source for the CPU loops that vectorise
+// it over the rows (fluid_lattice.cpp) and the GPU's one thread per cell.
 #include "engine/lattice/d3q19.hpp"
-
-// The collision must be inlined into the vectorised row loop; GCC and Clang
-// need telling, other compilers get plain inline.
-#if defined(__GNUC__)
-#define FLOCSIM_ALWAYS_INLINE inline __attribute__((always_inline))
-#define FLOCSIM_LAMBDA_ALWAYS_INLINE __attribute__((always_inline))
-#else
-#define FLOCSIM_ALWAYS_INLINE inline
-#define FLOCSIM_LAMBDA_ALWAYS_INLINE
-#endif
+#include "engine/lattice/kernel_body.hpp"
 
 namespace flocsim::lattice {
 
@@ -28,11 +19,11 @@ struct CollisionConstants {
 // TRT collision with Guo forcing, on the deviations f_i - w_i of one cell, in
 // place. F is the force density acting on the cell.
 template <class Real>
-FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[d3q19::kQ], Real Fx, Real Fy, Real Fz,
+FLOCSIM_KERNEL_BODY void collide(Real (&f)[d3q19::kQ], Real Fx, Real Fy, Real Fz,
                                    const CollisionConstants<Real>& k) {
   using namespace d3q19;
   Real drho = 0;
-#pragma GCC unroll 19
+FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) drho += f[i];
   const Real rho = Real(1) + drho;
   const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
@@ -52,11 +43,11 @@ FLOCSIM_ALWAYS_INLINE void collide(Real (&f)[d3q19::kQ], Real Fx, Real Fy, Real 
     f[0] += -k.omega_plus * (f[0] - eq) - k.force_plus * w0 * uF3;
   }
   // Moving populations, one opposite pair (i, i+1) at a time; c = c_i.
-#pragma GCC unroll 9
+FLOCSIM_UNROLL
   for (int i = 1; i < kQ; i += 2) {
-    const Real wi = Real(w[i]);
-    const Real cu = Real(cx[i]) * ux + Real(cy[i]) * uy + Real(cz[i]) * uz;
-    const Real cF = Real(cx[i]) * Fx + Real(cy[i]) * Fy + Real(cz[i]) * Fz;
+    const Real wi = Real(weight_of(i));
+    const Real cu = Real(velocity_x(i)) * ux + Real(velocity_y(i)) * uy + Real(velocity_z(i)) * uz;
+    const Real cF = Real(velocity_x(i)) * Fx + Real(velocity_y(i)) * Fy + Real(velocity_z(i)) * Fz;
     const Real eq_plus = wi * (drho + rho * (Real(4.5) * cu * cu - usq15));
     const Real eq_minus = wi * rho * Real(3) * cu;
     const Real force_plus = wi * (Real(9) * cu * cF - uF3);
