@@ -1,4 +1,4 @@
-// flocsim run CASE.json --out DIR [--resume] [--quiet]
+// flocsim run CASE.json --out DIR [--resume] [--quiet] [--device cpu|cuda]
 // One solver instance; also what the orchestrator's workers execute.
 // Exit codes: 0 completed, 1 failed, 2 input refused, 3 stopped by a signal
 // after writing a checkpoint (continue with --resume).
@@ -7,6 +7,7 @@
 #include "apps/flocsim/command_registry.hpp"
 #include "engine/case/case_file.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/fluid_run.hpp"
 #include "engine/run/sphere_run.hpp"
@@ -20,13 +21,16 @@ struct RunArguments {
   bool resume = false;
   bool quiet = false;
   long stop_after_steps = 0;
+  std::string device;  // overrides the case's "device" when given
 };
 
 int run_command(const RunArguments& a) {
   // Read and validate the whole case before any work starts.
   cases::ParsedCase parsed;
   try {
-    parsed = cases::parse_case(input::read_json_file(a.case_file));
+    nlohmann::json document = input::read_json_file(a.case_file);
+    if (!a.device.empty() && document.is_object()) document["device"] = a.device;
+    parsed = cases::parse_case(document);
   } catch (const input::InputError& e) {
     // file-level refusals (read_json_file) already start with the file's name
     const std::string what = e.what();
@@ -34,6 +38,29 @@ int run_command(const RunArguments& a) {
     std::fprintf(stderr, "flocsim run: input error%s%s: %s\n", named ? "" : " in ",
                  named ? "" : a.case_file.c_str(), what.c_str());
     return kExitBadInput;
+  }
+  // A GPU that is not there is found out now, before any output is written.
+  if (parsed.fluid_scene && parsed.fluid.device == cases::Device::cuda) {
+    const gpu::GpuQuery q = gpu::query_gpus();
+    if (q.devices.empty()) {
+      std::fprintf(stderr, "flocsim run: input error in %s: device = \"cuda\": %s; run on the CPU "
+                   "with --device cpu\n", a.case_file.c_str(), q.why_none.c_str());
+      return kExitBadInput;
+    }
+    // the populations must fit the GPU's memory (the host mirror is checked
+    // with the case, against this machine's)
+    const double bytes = 19.0 * static_cast<double>(parsed.fluid.size.cells()) *
+                         (parsed.fluid.precision == cases::Precision::single_precision ? 4 : 8);
+    const double available = 0.9 * q.devices.front().memory_gib * (1u << 30);
+    if (bytes > available) {
+      std::fprintf(stderr,
+                   "flocsim run: input error in %s: fluid.size: the populations take %.1f GiB, "
+                   "more than 90 %% of the GPU's %.1f GiB (%s); use a smaller box, float "
+                   "precision, or --device cpu\n",
+                   a.case_file.c_str(), bytes / (1u << 30), q.devices.front().memory_gib,
+                   q.devices.front().name.c_str());
+      return kExitBadInput;
+    }
   }
   process::install_stop_handlers(process::SecondSignal::ends_the_process);
   run::RunOptions options;
@@ -69,6 +96,9 @@ const bool registered = register_command(
            ->check(CLI::ExistingFile);
        cmd.add_option("--out,-o", args->out_dir, "Output directory")->required();
        cmd.add_flag("--resume", args->resume, "Continue from OUT/checkpoint.h5 if it exists");
+       cmd.add_option("--device", args->device,
+                      "Where the lattice steps: cpu or cuda (overrides the case's \"device\")")
+           ->check(CLI::IsMember({"cpu", "cuda"}));
        cmd.add_flag("--quiet,-q", args->quiet, "Write only the log file, nothing on stderr");
        cmd.add_option("--stop-after", args->stop_after_steps,
                       "Stop after N steps as if SIGTERM arrived (checkpoint, exit 3); for tests")

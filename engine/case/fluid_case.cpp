@@ -50,6 +50,7 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   c.precision = root.choice("precision", {"double", "float"}, "double") == "float"
                     ? Precision::single_precision
                     : Precision::double_precision;
+  parse_device_name(root.choice("device", {"cpu", "cuda"}, "cpu"), c.device);
 
   InputReader fluid = root.object("fluid", true);
   const auto size = fluid.numbers("size", 3, {.at_least = 1, .at_most = 4096});
@@ -169,6 +170,9 @@ nlohmann::json FluidCase::to_json() const {
   nlohmann::json j;
   j["scene"] = std::string(scene_name(Scene::fluid));
   j["precision"] = precision == Precision::single_precision ? "float" : "double";
+  // written only off the default, so cases and checkpoints from before the
+  // field existed read the same
+  if (device != Device::cpu) j["device"] = device_name(device);
   auto& f = j["fluid"];
   f["size"] = {size.nx, size.ny, size.nz};
   f["viscosity"] = relaxation.viscosity;

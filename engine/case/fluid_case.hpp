@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "engine/case/device.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 
 namespace flocsim::cases {
@@ -44,6 +45,7 @@ struct RunControl {
 
 struct FluidCase {
   Precision precision = Precision::double_precision;
+  Device device = Device::cpu;  // "device": where the lattice steps (device.hpp)
   lattice::Extent size{32, 32, 32};
   lattice::Relaxation relaxation{0.01, 0.25};
   lattice::Vector3 body_force;

@@ -286,6 +286,14 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
   const Preset p = preset(c.fidelity);
   c.numerics.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
+  // The coupled step (immersed boundary, partially saturated cells, sphere
+  // averages) has no CUDA back-end yet: only the fluid scene's lattice runs
+  // on a GPU (docs/gpu.md says what moves next).
+  if (root.choice("device", {"cpu", "cuda"}, "cpu") == "cuda")
+    throw InputError(root.field("device") + " = \"cuda\": scene \"" +
+                     std::string(scene_name(c.scene)) +
+                     "\" runs on the CPU only (its coupled step has no CUDA back-end yet; the "
+                     "fluid scene's lattice runs on a GPU); give \"cpu\" or leave the field out");
   c.seed =
       static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 

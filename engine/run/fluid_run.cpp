@@ -3,11 +3,14 @@
 #include <omp.h>
 
 #include <cmath>
+#include <memory>
 
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
@@ -125,12 +128,34 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     base.momentum = fluid.total_momentum();
     base.amplitude = wave_amplitude(fluid, c);
   }
+  // On a GPU the lattice steps there, and `fluid` is the host mirror that the
+  // checkpoints, snapshots and final observables read: brought up to date by
+  // a download before each read, so they are the CPU run's code unchanged.
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
+  nlohmann::json device_record;
+  if (c.device == cases::Device::cuda) {
+    device = std::make_unique<gpu::GpuFluidLattice<Real>>(c.size, c.relaxation);
+    device->upload(fluid);
+    const gpu::GpuQuery q = gpu::query_gpus();
+    device_record = {{"kind", "cuda"},
+                     {"name", q.devices.front().name},
+                     {"memory_gib", q.devices.front().memory_gib},
+                     {"compute_capability", std::to_string(q.devices.front().compute_major) + "." +
+                                                std::to_string(q.devices.front().compute_minor)}};
+    log.info("lattice on GPU " + q.devices.front().name);
+  }
+  const auto time_step = [&] { return device ? device->time_step() : fluid.time_step(); };
+  const auto total_mass = [&] { return device ? device->total_mass() : fluid.total_mass(); };
+  const auto mirror = [&] {
+    if (device) device->download(fluid);
+  };
   log.info(std::string("flocsim ") + kFlocsimVersion + " fluid scene: " +
            std::to_string(c.size.nx) + " x " + std::to_string(c.size.ny) + " x " +
            std::to_string(c.size.nz) + " cells, nu = " + std::to_string(c.relaxation.viscosity) +
            " (tau = " + std::to_string(c.relaxation.tau_plus()) + "), " +
            (sizeof(Real) == 8 ? "double" : "float") + " precision, " +
-           std::to_string(omp_get_max_threads()) + " threads, " + std::to_string(c.run.steps) +
+           (device ? std::string("on the GPU") : std::to_string(omp_get_max_threads()) + " threads") +
+           ", " + std::to_string(c.run.steps) +
            " steps");
 
   ProgressReporter progress(log, o.out_dir / "progress.json", fluid.time_step(), c.run.steps,
@@ -144,12 +169,16 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   // non-finite; checking it every few steps costs about 1 % of the run.
   const long health_every = 100;
 
-  while (fluid.time_step() < c.run.steps) {
-    stages.run(fluid_stage, [&] { fluid.step(); });
-    const long t = fluid.time_step();
+  while (time_step() < c.run.steps) {
+    stages.run(fluid_stage, [&] {
+      if (!device) return fluid.step();
+      device->step();
+      device->synchronize();  // the stage's time is the step's, not its launch's
+    });
+    const long t = time_step();
 
     if (t % health_every == 0 || t == c.run.steps) {
-      const double mass = fluid.total_mass();
+      const double mass = total_mass();
       if (!std::isfinite(mass)) {
         return shell.blown_up("step " + std::to_string(t), "the liquid mass is no longer finite",
                               "velocities beyond the Mach limit or a viscosity too small for the "
@@ -158,12 +187,16 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     }
     if (c.run.write_fields && c.run.fields_every > 0 && t % c.run.fields_every == 0 &&
         t != c.run.steps)
-      stages.run(output_stage, [&] { write_fields(o.out_dir, fluid); });
+      stages.run(output_stage, [&] {
+        mirror();
+        write_fields(o.out_dir, fluid);
+      });
     const bool stop_now = shell.stop_requested(t);
     if ((stop_now || shell.checkpoint_due(t, c.run.checkpoint_every_s)) && t < c.run.steps) {
       // only a state that passed the health check is checkpointed
-      if (!std::isfinite(fluid.total_mass())) continue;
+      if (!std::isfinite(total_mass())) continue;
       stages.run(checkpoint_stage, [&] {
+        mirror();
         write_checkpoint(o.out_dir, fluid, c, base, base.wall_s + shell.wall_s());
       });
       shell.checkpoint_written(t);
@@ -171,9 +204,10 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     }
     progress.update(t);
   }
-  progress.finish(fluid.time_step());
+  progress.finish(time_step());
 
   // ---- final state and result.json ------------------------------------------
+  mirror();
   if (c.run.write_fields) stages.run(output_stage, [&] { write_fields(o.out_dir, fluid); });
 
   nlohmann::json obs;
@@ -220,6 +254,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   result["observables"] = obs;
   result["cost"] = shell.cost(base.wall_s, wall, c.run.steps, steps_here, stages);
   result["cost"]["MLUPS"] = fluid_s > 0 ? steps_here * n / fluid_s / 1e6 : 0.0;
+  if (device) result["device"] = device_record;
   const std::string mlups = std::to_string(result["cost"]["MLUPS"].get<double>());
   return shell.complete(std::move(result), wall, std::to_string(c.run.steps) + " steps",
                         " (" + mlups + " MLUPS)");

@@ -214,6 +214,9 @@ nlohmann::json physics_only(nlohmann::json c, bool steps_may_grow = true) {
     for (const char* key : {"threads", "progress_every_s", "checkpoint_every_s"})
       c[group].erase(key);
   }
+  // where the lattice stepped (cases/device.hpp): a checkpoint moves between
+  // devices, and a result is the same case's whichever device computed it
+  c.erase("device");
   if (steps_may_grow && c.value("scene", "") == cases::scene_name(cases::Scene::fluid) &&
       c.contains("run"))
     c["run"].erase("steps");

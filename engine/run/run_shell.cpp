@@ -1,5 +1,7 @@
 #include "engine/run/run_shell.hpp"
 
+#include <fstream>
+
 #include <omp.h>
 
 #include "engine/output/atomic_file.hpp"
@@ -72,6 +74,18 @@ RunReport RunShell::blown_up(const std::string& where, const std::string& what,
   return blown_up_run(log_, where, what, last_good_checkpoint_, checkpoint_, likely_causes);
 }
 
+nlohmann::json cpu_device_record() {
+  std::string model = "unknown CPU";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);)
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      model = line.substr(line.find(':') + 1);
+      model.erase(0, model.find_first_not_of(' '));
+      break;
+    }
+  return {{"kind", "cpu"}, {"name", model}, {"threads", omp_get_max_threads()}};
+}
+
 nlohmann::json RunShell::cost(double wall_before_s, double wall_s, long steps,
                               long steps_this_invocation, const TimedStages& stages) const {
   return {{"wall_s", wall_before_s + wall_s},
@@ -86,6 +100,8 @@ RunReport RunShell::complete(nlohmann::json result, double wall_s, const std::st
                              const std::string& rate) {
   result["status"] = "completed";
   result["flocsim_version"] = kFlocsimVersion;
+  // where it ran: a scene that stepped on a GPU has said so already
+  if (!result.contains("device")) result["device"] = cpu_device_record();
   result["completed_at"] = utc_timestamp();
   const fs::path file = options_.out_dir / "result.json";
   output::write_file_atomically(file, result.dump(2) + "\n");

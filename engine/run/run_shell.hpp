@@ -80,6 +80,10 @@ class RunShell {
   long first_step_ = 0;
 };
 
+// result.json's "device" of a run on the CPU: {"kind": "cpu", "name": the
+// processor's model, "threads"}; a run on a GPU records its own (fluid_run.cpp).
+nlohmann::json cpu_device_record();
+
 // Runs a scene's loop and turns a module's failure (event cap, I/O such as a
 // full disk) into a failed run; a refused input stays an input::InputError.
 template <class Loop>

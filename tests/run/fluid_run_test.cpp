@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "engine/case/case_file.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/field_snapshots.hpp"
@@ -379,6 +380,58 @@ TEST(DiskFull, AFluidRunSaysSoInItsLog) {
   EXPECT_NE(r.message.find("No space left on device"), std::string::npos) << r.message;
   EXPECT_NE(log.find("No space left on device"), std::string::npos) << log;
   fs::remove_all(o);
+}
+
+// ---- device (engine/case/device.hpp) ------------------------------------------
+
+TEST(Device, CaseFieldDefaultsToTheCpuAndIsWrittenOnlyOffTheDefault) {
+  const auto with = [](const std::string& device) {
+    json j = json::parse(R"({"scene": "fluid", "fluid": {"size": [8, 4, 4], "viscosity": 0.02}})");
+    if (!device.empty()) j["device"] = device;
+    return cases::parse_fluid_case(j);
+  };
+  EXPECT_EQ(with("").device, cases::Device::cpu);
+  // cases written before the field existed keep their canonical form (run ids)
+  EXPECT_FALSE(with("").to_json().contains("device"));
+  EXPECT_FALSE(with("cpu").to_json().contains("device"));
+  EXPECT_EQ(with("cuda").device, cases::Device::cuda);
+  EXPECT_EQ(with("cuda").to_json()["device"], "cuda");
+  try {
+    with("gpu");
+    FAIL() << "device \"gpu\" accepted";
+  } catch (const input::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("device"), std::string::npos) << what;
+    EXPECT_NE(what.find("gpu"), std::string::npos) << what;
+    EXPECT_NE(what.find("cuda"), std::string::npos) << what;
+  }
+}
+
+TEST(Device, ACheckpointOrResultMovesBetweenDevices) {
+  // the device is how a run is computed, like its threads: a checkpoint
+  // written on the GPU continues on the CPU, a result counts on either
+  const json cpu = shear_wave_case("double").to_json();
+  json cuda = cpu;
+  cuda["device"] = "cuda";
+  EXPECT_TRUE(resumable_under(cuda, cpu));
+  EXPECT_TRUE(resumable_under(cpu, cuda));
+  EXPECT_TRUE(completed_under(cuda, cpu));
+  json other = cuda;
+  other["precision"] = "float";  // what is computed still has to match
+  EXPECT_FALSE(resumable_under(other, cpu));
+}
+
+TEST(Device, SphereScenesRefuseCuda) {
+  for (const char* scene : {"suspension", "granular", "fixed-array", "single-sphere"}) {
+    json j = {{"scene", scene}, {"device", "cuda"}};
+    try {
+      cases::parse_case(j);
+      ADD_FAILURE() << scene << " accepted device cuda";
+    } catch (const input::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("runs on the CPU only"), std::string::npos)
+          << scene << ": " << e.what();
+    }
+  }
 }
 
 }  // namespace

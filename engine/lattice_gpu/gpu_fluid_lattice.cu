@@ -1,0 +1,245 @@
+// The GPU lattice's launchers: one thread per cell, a block per run of cells
+// along x (coalesced loads and stores in each direction's slot array), the
+// cell's work the shared kernel body aa_update_cell (engine/lattice/aa_cell.hpp).
+#include <string>
+#include <vector>
+
+#include "engine/lattice/aa_cell.hpp"
+#include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
+
+namespace flocsim::gpu {
+
+using lattice::AaSlots;
+using lattice::CollisionConstants;
+
+namespace {
+
+constexpr int kReductionThreads = 256;
+
+// Threads per block along x: whole warps covering a row where it fits.
+int threads_along_x(int nx) {
+  const int warps = (nx + 31) / 32;
+  return 32 * (warps < 16 ? warps : 16);
+}
+
+template <class Real, bool kForceField>
+__global__ void aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx,
+                               Real by, Real bz, const Real* __restrict__ Fx,
+                               const Real* __restrict__ Fy, const Real* __restrict__ Fz) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x;
+  if (x >= s.nx) return;
+  const int y = blockIdx.y, z = blockIdx.z;
+  Real fx = bx, fy = by, fz = bz;
+  if constexpr (kForceField) {
+    const long c = lattice::aa_cell_index(s, x, y, z);
+    fx += Fx[c];
+    fy += Fy[c];
+    fz += Fz[c];
+  }
+  lattice::aa_update_cell(s, x, y, z, even, fx, fy, fz, k);
+}
+
+// Per block: the sum over its cells of the mass excess (sum of deviations)
+// and of the momentum density j + F/2, in double, by a fixed tree.
+template <class Real>
+__global__ void moments_sum_kernel(AaSlots<Real> s, bool even, double bx, double by, double bz,
+                                   const Real* __restrict__ Fx, const Real* __restrict__ Fy,
+                                   const Real* __restrict__ Fz, double* __restrict__ partial) {
+  __shared__ double sums[4][kReductionThreads];
+  const long cells = static_cast<long>(s.nx) * s.ny * s.nz;
+  double m = 0, px = 0, py = 0, pz = 0;
+  for (long c = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x; c < cells;
+       c += static_cast<long>(gridDim.x) * blockDim.x) {
+    const int x = static_cast<int>(c % s.nx);
+    const int y = static_cast<int>((c / s.nx) % s.ny);
+    const int z = static_cast<int>(c / (static_cast<long>(s.nx) * s.ny));
+    Real f[d3q19::kQ];
+    lattice::aa_load_cell(s, x, y, z, even, f);
+    double d[d3q19::kQ];
+    for (int i = 0; i < d3q19::kQ; ++i) d[i] = f[i];
+    double cell = 0;
+    for (int i = 0; i < d3q19::kQ; ++i) cell += d[i];
+    m += cell;
+    const double hx = 0.5 * (bx + (Fx ? static_cast<double>(Fx[c]) : 0.0));
+    const double hy = 0.5 * (by + (Fy ? static_cast<double>(Fy[c]) : 0.0));
+    const double hz = 0.5 * (bz + (Fz ? static_cast<double>(Fz[c]) : 0.0));
+    px += d[1] - d[2] + d[7] - d[8] + d[9] - d[10] + d[11] - d[12] + d[13] - d[14] + hx;
+    py += d[3] - d[4] + d[7] - d[8] - d[9] + d[10] + d[15] - d[16] + d[17] - d[18] + hy;
+    pz += d[5] - d[6] + d[11] - d[12] - d[13] + d[14] + d[15] - d[16] - d[17] + d[18] + hz;
+  }
+  sums[0][threadIdx.x] = m;
+  sums[1][threadIdx.x] = px;
+  sums[2][threadIdx.x] = py;
+  sums[3][threadIdx.x] = pz;
+  __syncthreads();
+  for (int half = kReductionThreads / 2; half > 0; half /= 2) {
+    if (static_cast<int>(threadIdx.x) < half)
+      for (int q = 0; q < 4; ++q) sums[q][threadIdx.x] += sums[q][threadIdx.x + half];
+    __syncthreads();
+  }
+  if (threadIdx.x == 0)
+    for (int q = 0; q < 4; ++q) partial[4 * blockIdx.x + q] = sums[q][0];
+}
+
+}  // namespace
+
+template <class Real>
+struct GpuFluidLattice<Real>::Device {
+  Real* populations = nullptr;
+  long stride = 0;
+  Real* force[3] = {nullptr, nullptr, nullptr};
+  double* partial = nullptr;  // reduction blocks x 4
+  int reduction_blocks = 0;
+
+  ~Device() {
+    cudaFree(populations);
+    for (Real* f : force) cudaFree(f);
+    cudaFree(partial);
+  }
+};
+
+template <class Real>
+GpuFluidLattice<Real>::GpuFluidLattice(lattice::Extent extent, lattice::Relaxation relaxation)
+    : extent_(extent), relaxation_(relaxation), device_(std::make_unique<Device>()) {
+  relaxation_.check();
+  const GpuQuery q = query_gpus();
+  if (q.devices.empty()) throw std::runtime_error(q.why_none);
+  // Direction arrays start on 512-byte boundaries: every warp's loads of a
+  // row segment fall in as few memory transactions as the shift allows.
+  const long align = 512 / static_cast<long>(sizeof(Real));
+  device_->stride = (extent.cells() + align - 1) / align * align;
+  const std::size_t bytes = sizeof(Real) * static_cast<std::size_t>(device_->stride) * d3q19::kQ;
+  cuda_check(cudaMalloc(&device_->populations, bytes),
+             ("cudaMalloc of the populations (" + std::to_string(bytes >> 20) + " MiB)").c_str());
+  cuda_check(cudaMemset(device_->populations, 0, bytes), "cudaMemset of the populations");
+  int sms = 0;
+  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0), "device attribute");
+  device_->reduction_blocks = 4 * sms;
+  cuda_check(cudaMalloc(&device_->partial, sizeof(double) * 4 * device_->reduction_blocks),
+             "cudaMalloc of the reduction buffer");
+}
+
+template <class Real>
+GpuFluidLattice<Real>::~GpuFluidLattice() = default;
+
+template <class Real>
+void GpuFluidLattice<Real>::upload(const lattice::FluidLattice<Real>& host) {
+  const lattice::Extent& e = host.extent();
+  if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
+    throw std::invalid_argument("GPU lattice: upload from a lattice of another extent");
+  std::vector<Real> slots;
+  for (int i = 0; i < d3q19::kQ; ++i) {
+    host.save_slots(i, slots);
+    cuda_check(cudaMemcpy(device_->populations + i * device_->stride, slots.data(),
+                          sizeof(Real) * slots.size(), cudaMemcpyHostToDevice),
+               "upload of the populations");
+  }
+  time_step_ = host.time_step();
+  body_force_ = host.body_force();
+  const auto field = host.force_field_if_set();
+  if (!field.empty()) upload_force_field(field);
+}
+
+template <class Real>
+void GpuFluidLattice<Real>::download(lattice::FluidLattice<Real>& host) const {
+  const lattice::Extent& e = host.extent();
+  if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
+    throw std::invalid_argument("GPU lattice: download into a lattice of another extent");
+  std::vector<Real> slots(static_cast<std::size_t>(extent_.cells()));
+  for (int i = 0; i < d3q19::kQ; ++i) {
+    cuda_check(cudaMemcpy(slots.data(), device_->populations + i * device_->stride,
+                          sizeof(Real) * slots.size(), cudaMemcpyDeviceToHost),
+               "download of the populations");
+    host.restore_slots(i, slots);
+  }
+  host.set_time_step(time_step_);
+}
+
+template <class Real>
+void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<const Real>& field) {
+  const std::size_t bytes = sizeof(Real) * static_cast<std::size_t>(extent_.cells());
+  for (int d = 0; d < 3; ++d) {
+    if (!device_->force[d])
+      cuda_check(cudaMalloc(&device_->force[d], bytes), "cudaMalloc of the force field");
+    cuda_check(cudaMemcpy(device_->force[d], field.component[d], bytes, cudaMemcpyHostToDevice),
+               "upload of the force field");
+  }
+}
+
+template <class Real>
+void GpuFluidLattice<Real>::step() {
+  const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
+  CollisionConstants<Real> k;
+  k.omega_plus = static_cast<Real>(relaxation_.omega_plus());
+  k.omega_minus = static_cast<Real>(relaxation_.omega_minus());
+  k.force_plus = static_cast<Real>(1.0 - 0.5 * relaxation_.omega_plus());
+  k.force_minus = static_cast<Real>(1.0 - 0.5 * relaxation_.omega_minus());
+  const int threads = threads_along_x(extent_.nx);
+  const dim3 grid((extent_.nx + threads - 1) / threads, extent_.ny, extent_.nz);
+  const bool even = time_step_ % 2 == 0;
+  const Real bx = static_cast<Real>(body_force_.x), by = static_cast<Real>(body_force_.y),
+             bz = static_cast<Real>(body_force_.z);
+  if (device_->force[0])
+    aa_step_kernel<Real, true><<<grid, threads>>>(s, even, k, bx, by, bz, device_->force[0],
+                                                  device_->force[1], device_->force[2]);
+  else
+    aa_step_kernel<Real, false><<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr,
+                                                   nullptr);
+  cuda_check(cudaGetLastError(), "launch of the lattice step");
+  ++time_step_;
+}
+
+template <class Real>
+void GpuFluidLattice<Real>::synchronize() const {
+  cuda_check(cudaDeviceSynchronize(), "lattice step");
+}
+
+namespace {
+template <class Real>
+std::vector<double> block_sums(const AaSlots<Real>& s, bool even, lattice::Vector3 body,
+                               Real* const (&force)[3], double* partial, int blocks) {
+  moments_sum_kernel<Real><<<blocks, kReductionThreads>>>(s, even, body.x, body.y, body.z,
+                                                          force[0], force[1], force[2], partial);
+  cuda_check(cudaGetLastError(), "launch of the mass and momentum sums");
+  std::vector<double> host(4 * static_cast<std::size_t>(blocks));
+  cuda_check(cudaMemcpy(host.data(), partial, sizeof(double) * host.size(), cudaMemcpyDeviceToHost),
+             "mass and momentum sums");
+  return host;
+}
+}  // namespace
+
+template <class Real>
+double GpuFluidLattice<Real>::total_mass() const {
+  const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
+  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force, device_->partial,
+                               device_->reduction_blocks);
+  double excess = 0;
+  for (int b = 0; b < device_->reduction_blocks; ++b) excess += sums[4 * b];
+  return static_cast<double>(extent_.cells()) + excess;
+}
+
+template <class Real>
+lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const {
+  const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
+  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force, device_->partial,
+                               device_->reduction_blocks);
+  lattice::Vector3 p;
+  for (int b = 0; b < device_->reduction_blocks; ++b) {
+    p.x += sums[4 * b + 1];
+    p.y += sums[4 * b + 2];
+    p.z += sums[4 * b + 3];
+  }
+  return p;
+}
+
+template <class Real>
+std::size_t GpuFluidLattice<Real>::bytes_per_cell_update() const {
+  return (2 * d3q19::kQ + (device_->force[0] ? 3 : 0)) * sizeof(Real);
+}
+
+template class GpuFluidLattice<float>;
+template class GpuFluidLattice<double>;
+
+}  // namespace flocsim::gpu

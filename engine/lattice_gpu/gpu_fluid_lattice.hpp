@@ -1,0 +1,68 @@
+#pragma once
+// The liquid on a GPU: the D3Q19 TRT lattice of fluid_lattice.hpp with its
+// populations in device memory, stepped by the same kernel body
+// (engine/lattice/aa_cell.hpp, one thread per cell) in the same storage
+// layout, so a state moves between the two by plain copies: upload() from a
+// host FluidLattice and download() back, bit for bit. The host lattice is the
+// run's mirror: checkpoints, snapshots and observables read it after a
+// download, and a checkpoint written from a GPU run resumes on either device.
+//
+// Reductions (mass, momentum) sum per cell in double, per block in a fixed
+// tree, and the blocks on the host in order: the same state gives the same
+// sum on every run (no atomics).
+//
+// Declared without CUDA headers, so host code compiled by the C++ compiler
+// uses it; a build without CUDA has the class but its constructor throws with
+// the reason (gpu_runtime.hpp).
+#include <cstddef>
+#include <memory>
+
+#include "engine/lattice/fluid_lattice.hpp"
+
+namespace flocsim::gpu {
+
+template <class Real>
+class GpuFluidLattice {
+ public:
+  // On the current CUDA device (0 unless CUDA_VISIBLE_DEVICES says otherwise);
+  // throws std::runtime_error when no GPU can be used, with the reason.
+  GpuFluidLattice(lattice::Extent extent, lattice::Relaxation relaxation);
+  ~GpuFluidLattice();
+  GpuFluidLattice(const GpuFluidLattice&) = delete;
+  GpuFluidLattice& operator=(const GpuFluidLattice&) = delete;
+
+  const lattice::Extent& extent() const { return extent_; }
+  long time_step() const { return time_step_; }
+  void set_body_force(lattice::Vector3 f) { body_force_ = f; }
+  lattice::Vector3 body_force() const { return body_force_; }
+
+  // The whole state of `host` (populations, time step, body force and, when
+  // it has one, its per-cell force field) onto the device; same extent.
+  void upload(const lattice::FluidLattice<Real>& host);
+  // The populations and the time step back into `host` (same extent).
+  void download(lattice::FluidLattice<Real>& host) const;
+  // The per-cell force field of the next steps, from the host (x fastest).
+  void upload_force_field(const lattice::ForceFieldView<const Real>& field);
+
+  // One lattice-Boltzmann step: collide with the current force, stream.
+  void step();
+  // Waits for the queued steps (timing).
+  void synchronize() const;
+
+  double total_mass() const;
+  lattice::Vector3 total_momentum() const;
+  std::size_t bytes_per_cell_update() const;
+
+ private:
+  struct Device;  // device memory, defined in the .cu
+  lattice::Extent extent_;
+  lattice::Relaxation relaxation_;
+  lattice::Vector3 body_force_;
+  long time_step_ = 0;
+  std::unique_ptr<Device> device_;
+};
+
+extern template class GpuFluidLattice<float>;
+extern template class GpuFluidLattice<double>;
+
+}  // namespace flocsim::gpu

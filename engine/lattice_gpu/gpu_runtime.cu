@@ -1,0 +1,93 @@
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
+
+namespace flocsim::gpu {
+
+bool built_with_cuda() { return true; }
+
+GpuQuery query_gpus() {
+  GpuQuery q;
+  int count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess || count == 0) {
+    // without a driver the runtime says its version is "insufficient"
+    const bool no_driver = status == cudaErrorInsufficientDriver;
+    q.why_none = std::string(no_driver ? "no NVIDIA driver on this machine"
+                                       : "no CUDA GPU is visible to this process") +
+                 " (CUDA: " +
+                 (status != cudaSuccess ? cudaGetErrorString(status) : "no device found") + ")";
+    if (const char* visible = std::getenv("CUDA_VISIBLE_DEVICES"))
+      q.why_none += std::string(", CUDA_VISIBLE_DEVICES=\"") + visible + "\"";
+    cudaGetLastError();  // clear the sticky error of a failed query
+    return q;
+  }
+  std::string too_old;
+  for (int d = 0; d < count; ++d) {
+    cudaDeviceProp p{};
+    if (cudaGetDeviceProperties(&p, d) != cudaSuccess) continue;
+    // The build carries machine code for FLOCSIM_CUDA_MIN_ARCH (Hopper, 90)
+    // and PTX that newer GPUs compile; older ones cannot run it.
+    if (p.major * 10 + p.minor < FLOCSIM_CUDA_MIN_ARCH) {
+      too_old += std::string(too_old.empty() ? "" : "; ") + p.name + " (compute capability " +
+                 std::to_string(p.major) + "." + std::to_string(p.minor) + ")";
+      continue;
+    }
+    q.devices.push_back({d, p.name, static_cast<double>(p.totalGlobalMem) / (1u << 30), p.major,
+                         p.minor});
+  }
+  if (q.devices.empty())
+    q.why_none = "the visible GPUs are older than this build's code (compute capability " +
+                 std::to_string(FLOCSIM_CUDA_MIN_ARCH / 10) + "." +
+                 std::to_string(FLOCSIM_CUDA_MIN_ARCH % 10) + " and newer): " + too_old +
+                 "; configure with -DCMAKE_CUDA_ARCHITECTURES=<theirs> to build for them";
+  return q;
+}
+
+namespace {
+// The copy the lattice's step is measured against: every byte read once and
+// written once, in wide coalesced loads and stores.
+__global__ void copy_kernel(const double2* __restrict__ in, double2* __restrict__ out,
+                            std::size_t n) {
+  for (std::size_t i = blockIdx.x * static_cast<std::size_t>(blockDim.x) + threadIdx.x; i < n;
+       i += static_cast<std::size_t>(gridDim.x) * blockDim.x)
+    out[i] = in[i];
+}
+}  // namespace
+
+double measure_copy_bandwidth_gbs(std::size_t bytes, int reps) {
+  const std::size_t n = bytes / sizeof(double2);
+  double2 *in = nullptr, *out = nullptr;
+  cuda_check(cudaMalloc(&in, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
+  cuda_check(cudaMalloc(&out, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
+  cuda_check(cudaMemset(in, 0, n * sizeof(double2)), "cudaMemset");
+  int sms = 0;
+  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0), "device attribute");
+  const int blocks = sms * 8, threads = 256;
+  cudaEvent_t start, stop;
+  cudaEventCreate(&start);
+  cudaEventCreate(&stop);
+  copy_kernel<<<blocks, threads>>>(in, out, n);  // warm-up
+  std::vector<double> rates;
+  for (int r = 0; r < reps; ++r) {
+    cudaEventRecord(start);
+    copy_kernel<<<blocks, threads>>>(in, out, n);
+    cudaEventRecord(stop);
+    cuda_check(cudaEventSynchronize(stop), "copy benchmark");
+    float ms = 0;
+    cudaEventElapsedTime(&ms, start, stop);
+    rates.push_back(2.0 * n * sizeof(double2) / (ms * 1e-3) / 1e9);
+  }
+  cudaEventDestroy(start);
+  cudaEventDestroy(stop);
+  cudaFree(in);
+  cudaFree(out);
+  std::sort(rates.begin(), rates.end());
+  return rates[rates.size() / 2];
+}
+
+}  // namespace flocsim::gpu

@@ -1,0 +1,35 @@
+#pragma once
+// What this build and this machine offer the CUDA back-end: whether the build
+// has it at all (a CUDA compiler was found when it was configured), which GPUs
+// the process sees, and why none can be used when none can. Every caller that
+// may run on a GPU asks here first, so a case that wants one is refused
+// before any work with the reason (docs/gpu.md).
+#include <string>
+#include <vector>
+
+namespace flocsim::gpu {
+
+struct GpuDevice {
+  int index = 0;  // CUDA's index among the visible devices
+  std::string name;
+  double memory_gib = 0;
+  int compute_major = 0, compute_minor = 0;
+};
+
+struct GpuQuery {
+  std::vector<GpuDevice> devices;  // the usable ones
+  std::string why_none;            // empty when devices is not empty
+};
+
+// True when this build carries the CUDA back-end.
+bool built_with_cuda();
+// The GPUs this process can run on; with none, the reason (no CUDA in the
+// build, no driver, no device visible, a device too old for the build's code).
+GpuQuery query_gpus();
+
+// Device-to-device copy bandwidth of GPU 0 (bytes read + bytes written per
+// second, GB/s): the roofline of a memory-bound kernel, measured with a copy
+// of `bytes` repeated `reps` times; the median of the repetitions.
+double measure_copy_bandwidth_gbs(std::size_t bytes, int reps);
+
+}  // namespace flocsim::gpu
