@@ -182,7 +182,17 @@ struct Worker {
   double term_sent = 0;
   bool kill_sent = false;
   bool lease_expired = false;
+  int gpu = -1;  // the GPU given to it (CUDA_VISIBLE_DEVICES), -1 none
 };
+
+// The GPU (0 .. gpus - 1) that the fewest running workers use, the lowest
+// index among equals: workers spread over the GPUs one each, then share.
+int least_busy_gpu(const std::vector<Worker>& running, int gpus) {
+  std::vector<int> load(static_cast<std::size_t>(gpus), 0);
+  for (const Worker& w : running)
+    if (w.gpu >= 0 && w.gpu < gpus) ++load[static_cast<std::size_t>(w.gpu)];
+  return static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+}
 
 void write_case_file(const std::string& run_dir, const std::string& case_json) {
   const fs::path dir(run_dir);
@@ -281,7 +291,16 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
         if (resume) argv.push_back("--resume");
         argv.push_back("--quiet");
         Worker w;
-        w.pid = spawn(argv, run.run_dir + "/worker.log");
+        std::vector<std::pair<std::string, std::string>> env;
+        if (!o.device.empty()) {
+          argv.push_back("--device");
+          argv.push_back(o.device);
+        }
+        if (o.device == "cuda" && o.gpus > 1) {
+          w.gpu = least_busy_gpu(workers, o.gpus);
+          env.emplace_back("CUDA_VISIBLE_DEVICES", std::to_string(w.gpu));
+        }
+        w.pid = spawn(argv, run.run_dir + "/worker.log", env);
         w.pid_start = process_start_time(w.pid);
         w.attempt_id = claim->attempt_id;
         w.run = run;

@@ -37,6 +37,11 @@ struct PoolOptions {
   double grace_s = 120;  // how long a stopping worker may take to checkpoint
   std::string backend = "local";
   std::string job_id;           // backend job id recorded in attempts
+  // "cpu" or "cuda": passed to every worker as --device; empty: each case's
+  // own "device". With cuda and `gpus` > 1, each worker gets the GPU that
+  // runs the fewest workers (CUDA_VISIBLE_DEVICES), so jobs > gpus shares them.
+  std::string device;
+  int gpus = 1;
   std::ostream* out = nullptr;  // progress lines; nothing when null
 };
 

@@ -54,10 +54,25 @@ bool process_alive(pid_t pid, const std::string& start_time) {
   return true;
 }
 
-pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file) {
+pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file,
+            const std::vector<std::pair<std::string, std::string>>& environment) {
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  // The worker's environment, built before fork (setenv is not safe between
+  // fork and exec): this process's, with `environment` replacing or adding.
+  std::vector<std::string> env_text;
+  for (char** e = environ; *e; ++e) {
+    const std::string entry(*e);
+    bool replaced = false;
+    for (const auto& [name, value] : environment)
+      replaced = replaced || entry.rfind(name + "=", 0) == 0;
+    if (!replaced) env_text.push_back(entry);
+  }
+  for (const auto& [name, value] : environment) env_text.push_back(name + "=" + value);
+  std::vector<char*> envp;
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
   const pid_t parent = getpid();
   const int log_fd = open(log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0)
@@ -84,7 +99,7 @@ pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file) {
     if (null_fd >= 0) dup2(null_fd, 0);
     dup2(log_fd, 1);
     dup2(log_fd, 2);
-    execv(args[0], args.data());
+    execve(args[0], args.data(), envp.data());
     const char msg[] = "flocsim sweep: cannot execute the worker program\n";
     (void)!write(2, msg, sizeof msg - 1);
     _exit(127);

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "db/results_db.hpp"
@@ -25,8 +26,10 @@ bool process_alive(pid_t pid, const std::string& start_time = "");
 // stops workers itself). On Linux the worker gets SIGTERM when the process
 // that started it dies, so it checkpoints instead of running on unwatched.
 // Only async-signal-safe calls happen between fork and exec: no database
-// connection is touched in the child.
-pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file);
+// connection is touched in the child. `environment` adds to or replaces
+// variables of the worker's environment (a GPU: CUDA_VISIBLE_DEVICES).
+pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file,
+            const std::vector<std::pair<std::string, std::string>>& environment = {});
 
 // What progress.json says (the heartbeat); empty when absent or unreadable.
 std::optional<db::Heartbeat> read_progress(const std::string& run_dir);

@@ -107,6 +107,9 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   const std::string time_limit = slurm.value("time_limit", std::string("01:00:00"));
   const std::string partition = slurm.value("partition", std::string());
   const int cpus = slurm.value("cpus_per_task", 1);
+  // a GPU per task when the workers run on cuda, unless the sweep says which
+  const std::string gres =
+      slurm.value("gres", std::string(l.device == "cuda" ? "gpu:1" : ""));
 
   // What to do: claimable runs of the sweep (the tasks claim them for real).
   std::vector<db::RunRecord> to_submit;
@@ -128,6 +131,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   for (std::size_t i = 0; i < to_submit.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
     // states go to the task file as their stored text (db/run_state.hpp to_json)
     nlohmann::json task{{"states", l.states}, {"runs", nlohmann::json::array()}};
+    if (!l.device.empty()) task["device"] = l.device;
     for (std::size_t j = i; j < std::min(to_submit.size(), i + static_cast<std::size_t>(per_task));
          ++j)
       task["runs"].push_back(to_submit[j].id);
@@ -135,7 +139,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
   }
   const fs::path script = job_dir / "job.sh";
   // a #SBATCH line ends at a line break: none may come from a path or a name
-  for (const std::string& v : {sweep.name, job_dir.string(), partition, time_limit})
+  for (const std::string& v : {sweep.name, job_dir.string(), partition, time_limit, gres})
     if (v.find_first_of("\n\r") != std::string::npos)
       throw std::runtime_error("cannot write a Slurm job script with a line break in " +
                                flocsim::input::shown(v));
@@ -149,7 +153,8 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
       << "#SBATCH --cpus-per-task=" << cpus << "\n"
       << "#SBATCH --ntasks=1\n"
       << "#SBATCH --output=" << (job_dir / "task_%a.out").string() << "\n"
-      << (partition.empty() ? "" : "#SBATCH --partition=" + partition + "\n") << "exec "
+      << (partition.empty() ? "" : "#SBATCH --partition=" + partition + "\n")
+      << (gres.empty() ? "" : "#SBATCH --gres=" + gres + "\n") << "exec "
       << shell_quote(l.flocsim) << " sweep slurm-task --db "
       << shell_quote(fs::absolute(db.path()).string()) << " --sweep " << shell_quote(sweep.name)
       << " --task-file " << shell_quote((job_dir).string()) << "/task_${SLURM_ARRAY_TASK_ID}.json"
@@ -217,6 +222,7 @@ int run_slurm_task(db::ResultsDb& db, const db::SweepRecord& sweep, const std::s
     throw std::runtime_error("Slurm task file " + task_file + ": " + e.what());
   }
   p.only_runs = task.at("runs").get<std::vector<std::string>>();
+  p.device = task.value("device", std::string());  // the task's GPU is the one Slurm gave it
   p.lease_s = lease_s;
   p.backend = "slurm";
   const char* job = std::getenv("SLURM_ARRAY_JOB_ID");

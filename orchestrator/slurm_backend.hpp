@@ -18,6 +18,7 @@ namespace flocsim::orchestrator {
 struct SlurmLaunch {
   std::string worker;   // program run as `WORKER run CASE --out DIR` inside the tasks
   std::string flocsim;  // this flocsim, run as `flocsim sweep slurm-task` by each task
+  std::string device;   // "cpu", "cuda" or empty (each case's own): --device of the workers
   std::vector<db::RunState> states{db::RunState::kPending, db::RunState::kInterrupted,
                                    db::RunState::kLost};
   double lease_s = 60;

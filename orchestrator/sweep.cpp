@@ -193,11 +193,13 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
         static_cast<int>(slurm.integer("runs_per_task", {.at_least = 1, .at_most = 10000}, 1));
     s.slurm.time_limit = slurm.text("time_limit", "01:00:00");
     s.slurm.partition = slurm.text("partition", "");
+    s.slurm.gres = slurm.text("gres", "");
     // both go into the job script's #SBATCH lines: one word each, so that no
     // value can end a line and start a shell command there
     for (const auto& [field, value] :
          {std::pair<std::string, std::string>{"slurm.time_limit", s.slurm.time_limit},
-          {"slurm.partition", s.slurm.partition}})
+          {"slurm.partition", s.slurm.partition},
+          {"slurm.gres", s.slurm.gres}})
       if (value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
                                   "0123456789:-_.,") != std::string::npos)
         throw InputError(field + " = " + flocsim::input::shown(value) +

@@ -48,6 +48,9 @@ struct SlurmOptions {
   std::string partition;
   int max_parallel = 0;  // array throttle (%k); 0 = no throttle
   int cpus_per_task = 1;
+  // generic resources per task (#SBATCH --gres); empty: "gpu:1" when the
+  // sweep runs on cuda, none otherwise
+  std::string gres;
 };
 
 struct SweepSpec {

@@ -13,7 +13,9 @@
 
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
+#include "engine/case/case_file.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/plan.hpp"
@@ -30,6 +32,7 @@ using db::RunState;
 
 struct SweepOptions {
   std::string sweep_file, db_path, runs_dir, backend = "local", worker, sweep_name;
+  std::string device;  // --device: every worker's, overriding the cases' own
   int jobs = 1;
   double lease_s = 60;
   double grace_s = 120;
@@ -88,8 +91,31 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
                                    (known.empty() ? "none" : known) + ")");
 }
 
+// --device cuda is checked before anything is recorded or started: the build
+// and (local backend) this machine must have a GPU, and every point of the
+// grid must be a case that runs on one. Returns the GPUs the pool spreads
+// its workers over (1 where they are not counted here).
+int check_device(const SweepOptions& o, const std::vector<orc::RunPoint>& points) {
+  if (o.device != "cuda") return 1;
+  const gpu::GpuQuery q = gpu::query_gpus();
+  if (!gpu::built_with_cuda() || (o.backend == "local" && q.devices.empty()))
+    throw flocsim::input::InputError("--device cuda: " + q.why_none +
+                                     "; run on the CPU with --device cpu");
+  for (const orc::RunPoint& p : points) {
+    nlohmann::json c = p.case_json;
+    c["device"] = "cuda";
+    try {
+      cases::parse_case(c);
+    } catch (const flocsim::input::InputError& e) {
+      throw flocsim::input::InputError("--device cuda: grid point " + p.point.dump() + ": " +
+                                       e.what());
+    }
+  }
+  return q.devices.empty() ? 1 : static_cast<int>(q.devices.size());
+}
+
 int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
-              std::vector<RunState> states) {
+              std::vector<RunState> states, int gpus) {
   if (o.backend == "slurm") {
     orc::SlurmLaunch launch;
     launch.worker = o.worker.empty() ? default_worker() : o.worker;
@@ -98,6 +124,7 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
     launch.states = states;
     launch.lease_s = o.lease_s;
     launch.wait = !o.no_wait;
+    launch.device = o.device;
     launch.out = &std::cout;
     process::install_stop_handlers(process::SecondSignal::is_counted);
     const orc::SlurmSummary s = orc::run_slurm(db, sweep, launch);
@@ -111,6 +138,8 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
   p.states = std::move(states);
   p.lease_s = o.lease_s;
   p.grace_s = o.grace_s;
+  p.device = o.device;
+  p.gpus = gpus;
   p.out = &std::cout;
   process::install_stop_handlers(process::SecondSignal::is_counted);
   const orc::PoolSummary s = orc::run_pool(db, sweep, p);
@@ -164,6 +193,10 @@ void common_run_options(CLI::App& cmd, SweepOptions& o) {
                  "Program run as `WORKER run CASE --out DIR` (default: this flocsim, or "
                  "$FLOCSIM_WORKER)");
   cmd.add_flag("--no-wait", o.no_wait, "Slurm: submit and return without following the jobs");
+  cmd.add_option("--device", o.device,
+                 "Where every worker's lattice steps, cpu or cuda (default: each case's "
+                 "\"device\"); cuda gives each worker its own GPU while there are enough")
+      ->check(CLI::IsMember({"cpu", "cuda"}));
 }
 
 const bool registered = register_command(
@@ -250,7 +283,8 @@ const bool registered = register_command(
            }
            if (*action == "launch") {
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
-             orc::expand(spec);  // a grid refused here leaves no database file behind
+             // a grid refused here leaves no database file behind
+             const int gpus = check_device(*o, orc::expand(spec));
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
              if (o->worker.empty() && !std::getenv("FLOCSIM_WORKER")) {
                // what it will cost, on one screen, before anything starts (asks
@@ -271,15 +305,24 @@ const bool registered = register_command(
                        << "); run folders under " << std::filesystem::absolute(runs_dir).string()
                        << "\n";
              return run_sweep(*o, db, reg.sweep,
-                              {RunState::kPending, RunState::kInterrupted, RunState::kLost});
+                              {RunState::kPending, RunState::kInterrupted, RunState::kLost}, gpus);
            }
            if (*action == "resume") {
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
+             std::vector<orc::RunPoint> points;
+             if (!o->device.empty())
+               for (const db::RunRecord& r : db.runs(sweep.id))
+                 points.push_back({r.id, nlohmann::json::parse(r.case_json),
+                                   r.point_json.empty()
+                                       ? nlohmann::ordered_json::object()
+                                       : nlohmann::ordered_json::parse(r.point_json)});
+             const int gpus = check_device(*o, points);
              return run_sweep(
                  *o, db, sweep,
-                 {RunState::kPending, RunState::kInterrupted, RunState::kLost, RunState::kFailed});
+                 {RunState::kPending, RunState::kInterrupted, RunState::kLost, RunState::kFailed},
+                 gpus);
            }
            if (*action == "status") {
              // status only reads, but where it may write it also marks workers

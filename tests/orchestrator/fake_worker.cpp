@@ -1,7 +1,7 @@
 // A stand-in for `flocsim run` that honours the worker contract exactly and
 // whose behaviour the case chooses, so the orchestrator's fault handling can
 // be tested in seconds:
-//   fake_worker run CASE.json --out DIR [--resume] [--quiet]
+//   fake_worker run CASE.json --out DIR [--resume] [--quiet] [--device D]
 // Case fields read: "x" (number, default 0) and "fake": {
 //   "steps": 10, "step_ms": 50,      work: steps of step_ms each
 //   "exit": 0,                       exit code at the end (0 writes result.json)
@@ -12,7 +12,9 @@
 //   "by_x": {"2": {...}} }           overrides of these fields for the run with x = 2
 // Each step rewrites progress.json and checkpoint.h5 (the step number), both
 // atomically. SIGTERM/SIGINT: checkpoint, exit 3. --resume: continue from the
-// checkpoint. Every start appends "start STEP" to DIR/starts.log.
+// checkpoint. Every start appends "start STEP" to DIR/starts.log, and
+// "device D gpu G" to DIR/devices.log (D the --device given, G the
+// CUDA_VISIBLE_DEVICES it got; "-" for none).
 #include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
@@ -58,7 +60,14 @@ int main(int argc, char** argv) {
   }
   const std::string case_file = argv[2], dir = argv[4];
   bool resume = false;
-  for (int i = 5; i < argc; ++i) resume = resume || std::string(argv[i]) == "--resume";
+  std::string device = "-";
+  for (int i = 5; i < argc; ++i) {
+    resume = resume || std::string(argv[i]) == "--resume";
+    if (std::string(argv[i]) == "--device" && i + 1 < argc) device = argv[++i];
+  }
+  const char* gpu = std::getenv("CUDA_VISIBLE_DEVICES");
+  std::ofstream(dir + "/devices.log", std::ios::app)
+      << "device " << device << " gpu " << (gpu ? gpu : "-") << "\n";
   std::signal(SIGTERM, on_signal);
   std::signal(SIGINT, on_signal);
 

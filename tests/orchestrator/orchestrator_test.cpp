@@ -15,6 +15,7 @@
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
+#include "orchestrator/local_pool.hpp"
 #include "orchestrator/plan.hpp"
 #include "orchestrator/sweep.hpp"
 
@@ -102,6 +103,55 @@ class Orchestrator : public ::testing::Test {
   fs::path dir_;
   std::string db_;
 };
+
+TEST_F(Orchestrator, WorkersOnCudaGetTheirOwnGpuThenShare) {
+  // The pool on two GPUs with three workers at once (six runs, each long
+  // enough that the three overlap): every worker is told --device cuda, the
+  // first two get GPUs 0 and 1, and the third shares one. The command line
+  // refuses --device cuda where no GPU is usable, so this drives the pool
+  // itself, as `sweep launch` does once the GPUs are counted.
+  const flocsim::orchestrator::SweepSpec spec =
+      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2, 3, 4, 5, 6}, 6, 50));
+  ResultsDb db(db_, ResultsDb::Mode::kCreate);
+  const flocsim::orchestrator::Registered reg =
+      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = 3;
+  p.device = "cuda";
+  p.gpus = 2;
+  const flocsim::orchestrator::PoolSummary s = flocsim::orchestrator::run_pool(db, reg.sweep, p);
+  EXPECT_EQ(s.completed, 6);
+  std::map<double, std::string> gpu_of;
+  for (double x : {1, 2, 3, 4, 5, 6}) {
+    const std::string line = t::read_text(run_dir(x) / "devices.log");
+    EXPECT_EQ(line.rfind("device cuda gpu ", 0), 0u) << line;
+    gpu_of[x] = line.substr(16, line.size() - 17);
+    EXPECT_TRUE(gpu_of[x] == "0" || gpu_of[x] == "1") << line;  // only the two GPUs
+  }
+  // the first three start together, in grid order: one GPU each, then the
+  // least busy (the lower index among equals) takes the third
+  EXPECT_EQ(gpu_of[1], "0");
+  EXPECT_EQ(gpu_of[2], "1");
+  EXPECT_EQ(gpu_of[3], "0");
+}
+
+TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
+  const flocsim::orchestrator::SweepSpec spec = flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 10));
+  ResultsDb db(db_, ResultsDb::Mode::kCreate);
+  const flocsim::orchestrator::Registered reg =
+      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = 2;
+  ASSERT_EQ(flocsim::orchestrator::run_pool(db, reg.sweep, p).completed, 2);
+  for (double x : {1, 2}) {
+    const std::string line = t::read_text(run_dir(x) / "devices.log");
+    // the orchestrator's own CUDA_VISIBLE_DEVICES, if any, passes through untouched
+    const char* inherited = std::getenv("CUDA_VISIBLE_DEVICES");
+    EXPECT_EQ(line, std::string("device - gpu ") + (inherited ? inherited : "-") + "\n");
+  }
+}
 
 TEST_F(Orchestrator, LaunchRunsTheGridAndQueryShowsEveryResult) {
   const std::string sweep = fake_sweep({1, 2, 3, 4}, 4, 20);
