@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# The device check: on a machine with a GPU, runs the GPU tests, the GPU
+# fluid benchmark (with the device's copy bandwidth measured in the same run),
+# the CPU fluid benchmark on that machine's cores for the speed-up, and the
+# fluid scene at the paper's box size on the GPU and on the CPU, writing every
+# figure into one folder. Sized to finish in under 8 minutes, so a 15-minute
+# device session holds it and a rerun.
+#
+# Usage (from the repository root, on the GPU machine):
+#   scripts/device-check.sh [BUNDLE] [OUT]
+#     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
+#     OUT:    where the figures go (default $OUT, else device-check-out)
+# Exit 0 when every step ran and every GPU test passed; 1 otherwise (each
+# step's log says which).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+bundle=$(realpath "${1:-build/device-bundle}")
+out=${2:-${OUT:-device-check-out}}
+mkdir -p "$out"
+out=$(realpath "$out")
+export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+export FLOCSIM_EXE="$bundle/bin/flocsim" FLOCSIM_SOURCE_DIR="$root"
+export OMP_WAIT_POLICY=passive
+status=0
+started=$(date +%s)
+
+step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit code
+  local name=$1 limit=$2
+  shift 2
+  echo "== $name ($(($(date +%s) - started)) s in)" | tee -a "$out/summary.txt"
+  timeout "$limit" "$@" > "$out/$name.log" 2>&1
+  local rc=$?
+  echo "   exit $rc" | tee -a "$out/summary.txt"
+  tail -n 25 "$out/$name.log"
+  [[ $rc -eq 0 ]] || status=1
+}
+
+{
+  date -u
+  nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version --format=csv
+  nproc
+  lscpu | grep -i "model name"
+} > "$out/machine.txt" 2>&1
+cat "$out/machine.txt"
+
+# 1. the GPU against the CPU reference (tests/lattice_gpu)
+step gpu-tests 180 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
+
+# 2. the fluid kernel: paper's box and 256^3, float and double, against the
+#    device's copy bandwidth
+step bench-fluid-gpu 240 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
+  --json "$out/bench-fluid-gpu.json"
+
+# 3. the CPU kernel on this machine's cores, for the speed-up
+step bench-fluid-cpu 120 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
+  --size 144 --precision all --forcing uniform --json "$out/bench-fluid-cpu.json"
+
+# 4. the fluid scene at the paper's box (288 x 144 x 144): a shear wave with
+#    a body force, float and double, on the GPU; and on the CPU for the ratio
+for precision in float double; do
+  for device in cuda cpu; do
+    steps=4000
+    [[ $device == cpu ]] && steps=100
+    cat > "$out/paper-box-$precision-$device.json" <<CASE
+{"scene": "fluid", "precision": "$precision", "device": "$device",
+ "fluid": {"size": [288, 144, 144], "viscosity": 0.01, "body_force": [1e-7, 0, 0],
+           "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
+ "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
+CASE
+    step "run-paper-box-$precision-$device" 120 "$bundle/bin/flocsim" run \
+      "$out/paper-box-$precision-$device.json" --out "$out/run-paper-box-$precision-$device" --quiet
+  done
+done
+
+echo "== done in $(($(date +%s) - started)) s, status $status" | tee -a "$out/summary.txt"
+exit $status
