@@ -24,7 +24,7 @@ for p in "${programs[@]}"; do
     exit 2
   fi
 done
-if ! grep -q "FLOCSIM_HAVE_CUDA:INTERNAL=ON\|CMAKE_CUDA_COMPILER:FILEPATH=" "$build/CMakeCache.txt"; then
+if [[ ! -f $build/engine/libflocsim_lattice_gpu_kernels.a ]]; then
   echo "device-bundle: $build was configured without the CUDA back-end" >&2
   exit 2
 fi
@@ -40,6 +40,11 @@ done | sort -u | while read -r lib; do
     *) cp -L "$lib" "$bundle.tmp/lib/" ;;
   esac
 done
+# A native build (FLOCSIM_NATIVE, the default) runs only on processors with
+# this one's vector instructions: the device check compares before it starts.
+if grep -q "FLOCSIM_NATIVE:BOOL=ON" "$build/CMakeCache.txt"; then
+  grep -o -w "avx512f\|avx2\|fma" /proc/cpuinfo | sort -u > "$bundle.tmp/cpu-flags.txt"
+fi
 strip --strip-unneeded "$bundle.tmp"/bin/* 2>/dev/null || true
 rm -rf "$bundle"
 mv "$bundle.tmp" "$bundle"

@@ -25,6 +25,19 @@ export OMP_WAIT_POLICY=passive
 status=0
 started=$(date +%s)
 
+# binaries built for the build machine's vector instructions (FLOCSIM_NATIVE)
+# stop with "Illegal instruction" on a processor without them: say so first
+if [[ -f $bundle/cpu-flags.txt ]]; then
+  for flag in $(cat "$bundle/cpu-flags.txt"); do
+    if ! grep -q -w "$flag" /proc/cpuinfo; then
+      echo "device-check: this processor lacks $flag, which the bundle was built for; build" \
+           "with -DFLOCSIM_NATIVE=OFF and pack that build (scripts/device-bundle.sh BUILD_DIR)" \
+        | tee "$out/summary.txt"
+      exit 1
+    fi
+  done
+fi
+
 step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit code
   local name=$1 limit=$2
   shift 2
