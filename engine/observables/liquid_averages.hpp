@@ -20,7 +20,7 @@ struct LiquidAverages {
   double mean_velocity_x = 0;
   long liquid_cells = 0;
   // The same over every cell, the liquid inside the spheres included: the
-  // other reading of <u> (docs/validation.md, "Which <u>"). If the inside
+  // other reading of <u> (docs/validation/paper-baseline.md, "Which <u>"). If the inside
   // liquid moves with its sphere, (<u>_all - <u_p>) = (1 - phi)(<u> - <u_p>),
   // so a drag built on it reads F / (1 - phi).
   double mean_velocity_x_all_cells = 0;

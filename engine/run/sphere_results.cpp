@@ -69,7 +69,7 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
   if (modules.liquid) {
     for (const auto& col : kLiquidColumns)
       if (!col.steady_average.empty()) obs[key(col.steady_average)] = steady(window(col.name));
-    // F with <u> over every cell (docs/validation.md, "Which <u>"); F is the
+    // F with <u> over every cell (docs/validation/paper-baseline.md, "Which <u>"); F is the
     // liquid-only reading flocsim reports
     const auto f_all = window(column::F_all_cells);
     if (std::none_of(f_all.begin(), f_all.end(), [](double v) { return std::isnan(v); }))

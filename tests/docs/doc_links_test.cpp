@@ -1,6 +1,7 @@
-// Links inside the documentation: the summaries at the top of docs/validation.md,
-// docs/accuracy-cost.md and docs/immersed-boundary.md point at their sections by anchor, so a
-// renamed heading must fail here rather than leave a dead link for the reader.
+// Links inside the documentation: the summaries at the top of docs/accuracy-cost.md and
+// docs/immersed-boundary.md, and the summary docs/validation.md with its study pages under
+// docs/validation/, point at their sections by anchor, so a renamed heading or a moved page must
+// fail here rather than leave a dead link for the reader.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -106,4 +107,19 @@ TEST(DocLinks, EveryRelativeLinkNamesAnExistingFileAndSection) {
   }
   // The summaries link to their sections; finding none means the pattern above went wrong.
   EXPECT_GT(checked, 20);
+}
+
+TEST(DocLinks, TheValidationSummaryLinksEveryStudyPage) {
+  // docs/validation.md is a one-screen summary; each study has its own page in docs/validation/,
+  // which a reader finds only through the summary's links.
+  const std::string summary = read_text(kSource / "docs" / "validation.md");
+  int pages = 0;
+  for (const auto& entry : fs::directory_iterator(kSource / "docs" / "validation")) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".md") continue;
+    ++pages;
+    const std::string name = entry.path().filename().string();
+    EXPECT_NE(summary.find("](validation/" + name), std::string::npos)
+        << "docs/validation.md does not link docs/validation/" << name;
+  }
+  EXPECT_GT(pages, 5);
 }

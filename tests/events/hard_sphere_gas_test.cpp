@@ -96,7 +96,7 @@ TEST(HardSphereGas, ConservesEnergyAndMomentumAndMatchesEnskogCollisionRate) {
 // 2a (1 + eps) of a sphere is n * integral over that shell of g(r) 4 pi r^2 dr,
 // which for a thin shell is 8 phi g(sigma) ((1 + eps)^3 - 1) with the
 // Carnahan-Starling g(sigma). This is the "random arrangement" against which
-// docs/validation.md sets a settling suspension's baseline clustering.
+// docs/validation/paper-case.md sets a settling suspension's baseline clustering.
 TEST(HardSphereGas, ContactsPerSphereMatchTheCarnahanStarlingContactValue) {
   const double phi = 0.2, a = 1.0, dt = 0.05, eps = 0.003;
   Gas g = fcc_gas(6, a, phi, 7);  // 864 spheres
