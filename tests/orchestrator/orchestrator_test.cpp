@@ -15,6 +15,7 @@
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/plan.hpp"
 #include "orchestrator/sweep.hpp"
@@ -150,6 +151,44 @@ TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
     // the orchestrator's own CUDA_VISIBLE_DEVICES, if any, passes through untouched
     const char* inherited = std::getenv("CUDA_VISIBLE_DEVICES");
     EXPECT_EQ(line, std::string("device - gpu ") + (inherited ? inherited : "-") + "\n");
+  }
+}
+
+TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
+  // The job script and task files of a sweep launched on cuda, against a
+  // stand-in Slurm (squeue answers, sbatch keeps the script and gives a job
+  // id): each array task asks for one GPU unless the sweep names its gres,
+  // and tells its workers --device cuda. Needs a build with the CUDA
+  // back-end (a build without it refuses --device cuda, tested in test_cli).
+  if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
+  const fs::path bin = dir_ / "fake-slurm";
+  fs::create_directories(bin);
+  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+  t::write_text(bin / "sbatch", "#!/bin/sh\ncp \"$2\" \"$(dirname \"$0\")/job.sh\"\necho 4242\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  fs::permissions(bin / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  for (const std::string gres : {"", "gpu:h100:2"}) {
+    json sweep = json::parse(t::read_text(fs::path(FLOCSIM_SOURCE_DIR) / "sweeps/ci.json"));
+    sweep["name"] = gres.empty() ? "gpu-default" : "gpu-named";
+    if (!gres.empty()) sweep["slurm"]["gres"] = gres;
+    t::write_text(dir_ / "sweep.json", sweep.dump());
+    const t::Output o = t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db",
+                                        db_, "--backend", "slurm", "--no-wait", "--device",
+                                        "cuda"}),
+                               {path});
+    ASSERT_EQ(o.code, 0) << o.out;
+    const std::string script = t::read_text(bin / "job.sh");
+    EXPECT_NE(script.find("#SBATCH --gres=" + (gres.empty() ? "gpu:1" : gres) + "\n"),
+              std::string::npos)
+        << script;
+    // the task files beside the script carry the device to the tasks' pools
+    const std::string at = "#SBATCH --output=";
+    const std::size_t p = script.find(at);
+    ASSERT_NE(p, std::string::npos) << script;
+    const fs::path job_dir =
+        fs::path(script.substr(p + at.size(), script.find('\n', p) - p - at.size())).parent_path();
+    EXPECT_EQ(t::read_json(job_dir / "task_0.json").value("device", ""), "cuda");
   }
 }
 
