@@ -101,10 +101,14 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
       throw InputError(
           "numerics.immersed_boundary.marker_spacing = " + format_value(scheme.marker_spacing) +
           " with control forcing: " + coupling::dense_control_markers_why());
-    if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
-      throw InputError(
-          "numerics.immersed_boundary.sweeps: control forcing makes one correction "
-          "per step (1)");
+    // said as the reason, not as a range: "must be >= 1 and <= 1" hid why
+    if (ib.has("sweeps")) {
+      const long n = ib.integer("sweeps", {.at_least = 1, .at_most = 20});
+      if (n != 1)
+        throw InputError("numerics.immersed_boundary.sweeps = " + std::to_string(n) +
+                         ": control forcing makes one correction a step, so sweeps must be 1 "
+                         "(or left out)");
+    }
     scheme.sweeps = 1;
     scheme.gains = coupling::kControlScheme.gains;
     if (ib.has("gains")) {
@@ -114,9 +118,11 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
       scheme.gains.proportional =
           g.number("proportional", {.at_least = 0, .at_most = 100}, scheme.gains.proportional);
       if (!coupling::stable_gains(scheme.gains))
+        // the values as given (shortest round trip): rounded, (1, 1.0000001)
+        // read "{integral 1, proportional 1}", which the region holds
         throw InputError("numerics.immersed_boundary.gains = {integral " +
-                         format_value(scheme.gains.integral) + ", proportional " +
-                         format_value(scheme.gains.proportional) +
+                         exact_value(scheme.gains.integral) + ", proportional " +
+                         exact_value(scheme.gains.proportional) +
                          "}: " + coupling::stable_gains_region());
       g.finish();
     }

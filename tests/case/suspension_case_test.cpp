@@ -695,6 +695,24 @@ TEST(SuspensionCaseCoupling, ControlGainsOutsideTheMeasuredStableRegionAreRefuse
   }
 }
 
+// Issue 41, item 19: gains (1, 1.0000001) were refused as "{integral 1,
+// proportional 1}: outside the region" while (1, 1) is accepted; and sweeps 2
+// with control forcing said "must be >= 1 and <= 1".
+TEST(SuspensionCaseCoupling, RefusedGainsAreShownAsGivenAndSweepsSaysWhy) {
+  json c = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+  c["numerics"] = {
+      {"immersed_boundary",
+       {{"forcing", "control"}, {"gains", {{"integral", 1}, {"proportional", 1.0000001}}}}}};
+  EXPECT_THAT(refusal(c), HasSubstr("gains = {integral 1, proportional 1.0000001}"));
+  c["numerics"]["immersed_boundary"]["gains"]["proportional"] = 1;
+  EXPECT_NO_THROW(parse_suspension_case(c));
+  json sweeps = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+  sweeps["numerics"] = {{"immersed_boundary", {{"forcing", "control"}, {"sweeps", 2}}}};
+  EXPECT_THAT(refusal(sweeps), AllOf(HasSubstr("numerics.immersed_boundary.sweeps = 2"),
+                                     HasSubstr("control forcing makes one correction a step"),
+                                     ::testing::Not(HasSubstr("<= 1"))));
+}
+
 // Control forcing (markers 1 dx apart) and partially saturated cells take
 // their radius from the shipped table like the other schemes; a hand-given
 // radius must lie where the scheme puts its wall (control forcing: up to
