@@ -423,6 +423,16 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       return read_coupling(num, preset_scheme);
     };
     c.numerics.coupling = choose_scheme();
+    // A scene without liquid couples nothing: the options are read (and
+    // checked) but no scheme runs and none is recorded, as for the
+    // lubrication options of a scene without lubrication; said, not silent.
+    if (!modules_of(c.scene).liquid)
+      for (const char* key : {"coupling", "immersed_boundary"})
+        if (num.has(key))
+          c.warnings.push_back(std::string("numerics.") + key + ": scene \"" +
+                               std::string(scene_name(c.scene)) +
+                               "\" has no liquid, so no coupling runs; not recorded (leave it out: "
+                               "in a sweep it still changes the run's id)");
     // By default also stay clear of the multi-sweep coupling's oscillation
     // (below): raise U_inf until nu reaches its floor, where the Mach limit
     // allows, and choose again at that viscosity.

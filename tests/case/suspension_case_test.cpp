@@ -713,6 +713,26 @@ TEST(SuspensionCaseCoupling, RefusedGainsAreShownAsGivenAndSweepsSaysWhy) {
                                      ::testing::Not(HasSubstr("<= 1"))));
 }
 
+// Issue 41, item 18: a granular scene took immersed_boundary.forcing and
+// coupling "partially-saturated" without a word (and, in a sweep, a new run id).
+TEST(SuspensionCaseCoupling, CouplingOptionsOfAGranularSceneAreNamedAndNotRecorded) {
+  const json plain = json::parse(R"({"scene": "granular", "phi": 0.1, "fidelity": "draft"})");
+  const SuspensionCase base = parse_suspension_case(plain);
+  for (const json& numerics : {json{{"immersed_boundary", {{"forcing", "control"}}}},
+                               json{{"coupling", "partially-saturated"}}}) {
+    json c = plain;
+    c["numerics"] = numerics;
+    const SuspensionCase g = parse_suspension_case(c);
+    const std::string key = numerics.begin().key();
+    bool said = false;
+    for (const auto& w : g.warnings)
+      said = said || (w.find("numerics." + key + ": scene \"granular\" has no liquid") !=
+                      std::string::npos);
+    EXPECT_TRUE(said) << key;
+    EXPECT_EQ(g.to_json(), base.to_json()) << key;
+  }
+}
+
 // Control forcing (markers 1 dx apart) and partially saturated cells take
 // their radius from the shipped table like the other schemes; a hand-given
 // radius must lie where the scheme puts its wall (control forcing: up to
