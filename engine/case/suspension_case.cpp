@@ -380,6 +380,23 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     c.derived.settling_velocity =
         num.number("U_inf", u_range, liquid ? p.settling_velocity : kSettlingVelocityWithoutLiquid);
     c.numerics.viscosity = c.derived.settling_velocity * 2 * a / c.physics.reynolds_inf;
+    // The ceiling of a viscosity given directly holds for one implied by U_inf:
+    // nu = 2 a U_inf / Re_inf has no upper bound as Re_inf falls (Re_inf 0.01
+    // at draft: nu 56), and such runs blew up with hints that the viscosity
+    // was too small. Refused before any work, with the U_inf that keeps nu in range.
+    constexpr double kLargestViscosity = 1;  // numerics.viscosity's own limit (above)
+    if (liquid && c.numerics.viscosity > kLargestViscosity) {
+      const double u_works = c.physics.reynolds_inf * kLargestViscosity / (2 * a);
+      throw InputError("Re_inf = " + format_value(c.physics.reynolds_inf) +
+                       " with numerics.U_inf = " + format_value(c.derived.settling_velocity) +
+                       (has_u ? "" : " (the " + c.fidelity + " preset's)") + " and a_over_dx = " +
+                       format_value(a) + " implies numerics.viscosity = 2 a U_inf / Re_inf = " +
+                       format_value(c.numerics.viscosity) + ", above the largest accepted (" +
+                       format_value(kLargestViscosity) +
+                       "); give numerics.U_inf <= " + format_value(u_works) +
+                       " (or numerics.viscosity <= " + format_value(kLargestViscosity) +
+                       "), or a larger Re_inf");
+    }
     // by default stay inside the stable viscosity range: raise U_inf instead
     if (!has_u && c.numerics.viscosity < nu_min) {
       c.numerics.viscosity = nu_min;

@@ -733,6 +733,20 @@ TEST(SuspensionCaseCoupling, CouplingOptionsOfAGranularSceneAreNamedAndNotRecord
   }
 }
 
+// Issue 41, item 11: a low Re_inf with the preset's U_inf implied any viscosity
+// (Re_inf 0.01 at draft: nu 56) while the same viscosity given directly is
+// refused above 1; the runs blew up with hints pointing the other way.
+TEST(SuspensionCase, AViscosityImpliedAboveTheCeilingIsRefusedWithTheUInfThatWorks) {
+  json c =
+      json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft", "Re_inf": 0.01})");
+  EXPECT_THAT(refusal(c), AllOf(HasSubstr("numerics.viscosity = 2 a U_inf / Re_inf = 56"),
+                                HasSubstr("the draft preset's"), HasSubstr("U_inf <= 0.00125")));
+  c["numerics"] = {{"U_inf", 0.01}};
+  EXPECT_THAT(refusal(c), HasSubstr("numerics.viscosity = 2 a U_inf / Re_inf = 8"));
+  c["numerics"] = {{"U_inf", 0.001}};  // nu 0.8
+  EXPECT_NO_THROW(parse_suspension_case(c));
+}
+
 // Control forcing (markers 1 dx apart) and partially saturated cells take
 // their radius from the shipped table like the other schemes; a hand-given
 // radius must lie where the scheme puts its wall (control forcing: up to
