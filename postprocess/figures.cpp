@@ -140,10 +140,18 @@ struct Series {
       phi_x;
   std::size_t slabs = 0;
 };
-Series read_series(const RunSummary& r) {
+// `problem`: why there is none ("" when the file was read).
+Series read_series(const RunSummary& r, std::string* problem) {
   Series s;
   const fs::path file = fs::path(r.run_dir) / "series.h5";
-  if (r.run_dir.empty() || !fs::exists(file)) return s;
+  if (r.run_dir.empty()) {
+    *problem = "the database records no folder for it";
+    return s;
+  }
+  if (!fs::exists(file)) {
+    *problem = file.string() + " is missing";
+    return s;
+  }
   try {
     const output::Hdf5File f(file, output::Hdf5File::Mode::read);
     auto read = [&](const std::string& name, std::vector<double>& into) {
@@ -163,9 +171,12 @@ Series read_series(const RunSummary& r) {
       s.phi_x = f.read<double>("/phi_x", &shape);
       if (shape.size() == 2) s.slabs = shape[1];
     }
-  } catch (const std::exception&) {
-    return Series{};  // a truncated file of a running run: no series yet
+  } catch (const std::exception& e) {
+    // a truncated file of a running run: no series yet (said only of completed runs)
+    *problem = file.string() + " cannot be read (" + e.what() + ")";
+    return Series{};
   }
+  if (s.time.empty()) *problem = file.string() + " holds no time series (/time)";
   return s;
 }
 
@@ -271,8 +282,20 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
   // ---- per (phi, Re_inf): time series, p(n_a), g(r), h(theta) (Figs. 5, 7, 9, 2) ----
   std::map<std::pair<double, double>, std::vector<std::pair<const RunSummary*, Series>>> groups;
   for (const RunSummary& r : runs) {
-    Series s = read_series(r);
-    if (!s.time.empty()) groups[{r.phi, r.re_inf}].push_back({&r, std::move(s)});
+    std::string problem;
+    Series s = read_series(r, &problem);
+    if (!s.time.empty()) {
+      groups[{r.phi, r.re_inf}].push_back({&r, std::move(s)});
+    } else if (r.status == db::RunState::kCompleted) {
+      // a completed run the tables list but these figures cannot draw: never
+      // left out without a word (a running run simply has no series yet)
+      const std::string tag = label(r.phi, r.re_inf);
+      set.runs_left_out.push_back(
+          "run " + r.id.substr(0, 12) + " (phi = " + num(r.phi) + ", Re_inf = " + num(r.re_inf) +
+          ", du/U_inf = " + num(r.du) + "): " + problem + "; it is missing from the figures " +
+          "timeseries_" + tag + ", size_distribution_" + tag + ", pair_structure_" + tag +
+          " and spacetime_" + tag + "_du" + num(r.du));
+    }
   }
   if (groups.empty())
     set.skipped.push_back("time series, p(n_a), g(r), h(theta), phi(x,t): no series.h5 found");

@@ -103,6 +103,8 @@ int post(const std::string& what, const PostOptions& o) {
       if (what == "figures")
         for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
       for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
+      for (const auto& s : figures.runs_left_out)
+        std::cerr << "flocsim post: left out of figures: " << s << "\n";
       if (what == "report") {
         write_tables(runs, left_out, out, o);
         pp::write_report(runs, figures, o.db_path, out / "report.html", left_out);
