@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "engine/observables/reference_correlations.hpp"
+#include "engine/output/atomic_file.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "postprocess/paper_values.hpp"
 
@@ -86,7 +87,8 @@ class Plot {
   std::string data(const std::string& tag, const std::string& rows) {
     fs::create_directories(dir_ / "data");
     const std::string file = file_part(name_ + (tag.empty() ? "" : "_" + tag)) + ".dat";
-    std::ofstream(dir_ / "data" / file) << rows;
+    // by rename, never through a symbolic link left in the folder
+    output::write_file_atomically(dir_ / "data" / file, rows);
     return "'data/" + file + "'";
   }
   std::ostringstream& commands() { return commands_; }
@@ -113,14 +115,14 @@ class Plot {
     // The commands once per terminal, from a reset state, not replot: gnuplot 5.4's replot
     // after a multiplot redraws only its last panel.
     // (run in the figures folder: `cd figures && gnuplot scripts/NAME.gp` redraws)
-    std::ofstream(script) << "set terminal pngcairo size " << size_png
-                          << " enhanced font 'sans,11'\nset output '" << f.png.filename().string()
-                          << "'\n"
-                          << offsets << commands_.str() << "\nunset output\nreset\n"
-                          << "set terminal pdfcairo size " << size_pdf
-                          << " enhanced font 'sans,9'\nset output '" << f.pdf.filename().string()
-                          << "'\n"
-                          << offsets << commands_.str() << "\nunset output\n";
+    std::ostringstream text;
+    text << "set terminal pngcairo size " << size_png << " enhanced font 'sans,11'\nset output '"
+         << f.png.filename().string() << "'\n"
+         << offsets << commands_.str() << "\nunset output\nreset\n"
+         << "set terminal pdfcairo size " << size_pdf << " enhanced font 'sans,9'\nset output '"
+         << f.pdf.filename().string() << "'\n"
+         << offsets << commands_.str() << "\nunset output\n";
+    output::write_file_atomically(script, text.str());
     const fs::path log = dir_ / "scripts" / (name_ + ".log");
     if (run_gnuplot(dir_, "scripts/" + name_ + ".gp", log) != 0)
       throw std::runtime_error("gnuplot failed on figure " + name_ + "; see " + log.string());
