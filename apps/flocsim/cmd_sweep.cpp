@@ -289,12 +289,14 @@ const bool registered = register_command(
              try {
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kExisting);
                orc::reconcile_lost_workers(*opened, o->lease_s, &std::cout);
-             } catch (const db::ReadOnlyDbError&) {
+             } catch (const db::ReadOnlyDbError& e) {
                writable = false;
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
                std::cout << o->db_path
-                         << " is read-only: shown as recorded (workers that died are not "
-                            "marked lost)\n";
+                         << (dynamic_cast<const db::DiskFullDbError*>(&e)
+                                 ? ": the file system under it is full (free some space)"
+                                 : " is read-only")
+                         << ": shown as recorded (workers that died are not marked lost)\n";
              }
              db::ResultsDb& db = *opened;
              const std::optional<std::string> which =

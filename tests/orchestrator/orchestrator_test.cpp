@@ -579,6 +579,32 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
   EXPECT_NE(w.out.find(ro_db + " is read-only"), std::string::npos) << w.out;
 }
 
+// Issue 41, item 15: on a full file system `sweep status` and `resume` failed
+// with SQLite's "disk I/O error" and never mentioned space. Status reads the
+// database as it does a read-only one and says the disk is full.
+TEST_F(Orchestrator, AFullDiskIsNamedAndStatusStillReads) {
+  const fs::path full = dir_ / "full";
+  fs::create_directories(full);
+  if (::geteuid() != 0 ||
+      std::system(("mount -t tmpfs -o size=2m tmpfs " + full.string() + " 2>/dev/null").c_str()) !=
+          0)
+    GTEST_SKIP() << "cannot mount a small file system here (needs root)";
+  const std::string db = (full / "results.db").string();
+  const t::Output l = t::run(flocsim({"sweep", "launch", fake_sweep({1}, 1, 1, {{"exit", 1}}, 3),
+                                      "--db", db, "--worker", FAKE_WORKER_EXE}));
+  std::system(("dd if=/dev/zero of=" + (full / "fill").string() + " bs=4k 2>/dev/null").c_str());
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db}));
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db, "--worker", FAKE_WORKER_EXE}));
+  std::system(("umount " + full.string()).c_str());
+  EXPECT_EQ(l.code, 1) << l.out;
+  EXPECT_EQ(st.code, 0) << st.out;
+  EXPECT_NE(st.out.find("the file system under it is full"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("sweep fake"), std::string::npos) << st.out;
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("is full"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("disk I/O error"), std::string::npos) << r.out;
+}
+
 // The real worker: the CI sweep with `flocsim run`, then a real run killed with
 // SIGKILL and resumed from its HDF5 checkpoint.
 TEST_F(Orchestrator, PlanRefusesWhatLaunchRefusesAndCountsTheRunsLatticeUpdates) {
