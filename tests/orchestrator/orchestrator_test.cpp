@@ -263,6 +263,33 @@ TEST_F(Orchestrator, TruncatedResultIsNeverRecordedAndRetriesStopAtTheLimit) {
   EXPECT_NE(db.runs().front().error.find("not valid JSON"), std::string::npos);
 }
 
+// Issue 41, item 1: a result.json that another run wrote (here: the run of
+// x = 1, copied into the folder of the failed run of x = 2) was recorded by
+// `sweep resume` as "found complete on disk", and x = 2 held x = 1's result.
+TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
+  const std::string sweep = fake_sweep({2}, 2, 10, {{"exit", 1}}, 3);
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);
+  ASSERT_EQ(statuses()[2], "failed");
+  const fs::path other = dir_ / "other";
+  fs::create_directories(other);
+  t::write_text(dir_ / "other.json",
+                json{{"x", 1}, {"fake", {{"steps", 1}, {"step_ms", 1}}}}.dump());
+  ASSERT_EQ(
+      t::run({FAKE_WORKER_EXE, "run", (dir_ / "other.json").string(), "--out", other.string()})
+          .code,
+      0);
+  fs::copy_file(other / "result.json", run_dir(2) / "result.json",
+                fs::copy_options::overwrite_existing);
+  const t::Output r = t::run(resume());
+  EXPECT_EQ(r.out.find("found complete on disk"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("result of another case"), std::string::npos) << r.out;
+  EXPECT_EQ(statuses()[2], "failed");
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.count_results(db.runs().front().id), 0);
+  // the file is not this run's, and not flocsim's to remove
+  EXPECT_TRUE(fs::exists(run_dir(2) / "result.json"));
+}
+
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
   const t::Output o = t::run(launch(fake_sweep({1}, 2, 10, {{"refuse", true}})));
   EXPECT_EQ(o.code, 1);
