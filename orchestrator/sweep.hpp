@@ -80,4 +80,10 @@ inline constexpr std::size_t kMaxRunsPerSweep = 100000;
 // when it is not an object).
 std::string point_text(const std::string& point_json);
 
+// `word` as one word of a POSIX shell command a user may paste (the commands
+// flocsim suggests): as it is when it holds only letters, digits and
+// - _ . / : , + = @, single-quoted otherwise, so that no name or path runs as
+// a command ("$(touch X)" stays text).
+std::string shell_word(const std::string& word);
+
 }  // namespace flocsim::orchestrator

@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
@@ -288,6 +289,73 @@ TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
   EXPECT_EQ(db.count_results(db.runs().front().id), 0);
   // the file is not this run's, and not flocsim's to remove
   EXPECT_TRUE(fs::exists(run_dir(2) / "result.json"));
+}
+
+// Issue 41, item 6: the printed "restart what did not finish with: flocsim
+// sweep resume ... --sweep NAME" left the name unquoted, and a sweep named
+// $(touch${IFS}X) ran touch when the line was pasted into a shell.
+TEST_F(Orchestrator, SuggestedCommandsAreShellQuoted) {
+  const std::string name = "$(touch${IFS}PWNED)";
+  json s{{"name", name},
+         {"base", {{"x", 0}, {"fake", {{"steps", 1}, {"step_ms", 1}, {"exit", 1}}}}},
+         {"axes", {{"x", {1}}}}};
+  t::write_text(dir_ / "evil.json", s.dump());
+  const t::Output o = t::run(launch((dir_ / "evil.json").string()));
+  EXPECT_EQ(o.code, 1) << o.out;
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  for (const std::string& text : {o.out, st.out}) {
+    const auto at = text.find("flocsim sweep resume ");
+    ASSERT_NE(at, std::string::npos) << text;
+    const std::string line = text.substr(at, text.find('\n', at) - at);
+    // the line as a shell reads it, with echo in the place of flocsim
+    const t::Output echoed =
+        t::run({"/bin/sh", "-c", "cd " + dir_.string() + " && echo " + line.substr(8)});
+    EXPECT_EQ(echoed.out, "sweep resume --db " + db_ + " --sweep " + name + "\n") << line;
+    EXPECT_FALSE(fs::exists(dir_ / "PWNED")) << line;
+  }
+}
+
+// Issue 41, item 13: a missing --worker failed every run with exit 127,
+// naming no path, and each failure used up an attempt.
+TEST_F(Orchestrator, AWorkerThatCannotStartIsRefusedBeforeAnyAttempt) {
+  const std::string sweep = fake_sweep({1}, 1, 1, {{"exit", 1}}, 3);
+  const std::string missing = (dir_ / "no-such-worker").string();
+  const t::Output l = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--worker", missing}));
+  EXPECT_EQ(l.code, 2) << l.out;
+  EXPECT_NE(l.out.find("--worker " + missing + ": no such file"), std::string::npos) << l.out;
+  EXPECT_FALSE(fs::exists(db_)) << "registered before the refusal";
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);  // one real, failed attempt
+  t::write_text(dir_ / "not-executable", "#!/bin/sh\n");
+  for (const std::string& worker :
+       {missing, (dir_ / "not-executable").string(), std::string("no-such-program-on-path")}) {
+    const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_, "--worker", worker}));
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("--worker " + worker + ": "), std::string::npos) << r.out;
+  }
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 1);
+}
+
+// Issue 41, item 7: ESC sequences and U+202E in names and axis values reached
+// the terminal raw through launch, status and query.
+TEST_F(Orchestrator, ControlAndBidiCharactersAreShownEscaped) {
+  const std::string esc = "\x1b[2J", rlo = "\xe2\x80\xae";
+  json s{{"name", "n" + esc + "a" + rlo + "me"},
+         {"base", {{"x", 0}, {"fake", {{"steps", 1}, {"step_ms", 1}}}}},
+         {"axes", {{"label", {"red" + esc, "evil" + rlo + "gpj.exe"}}}}};
+  t::write_text(dir_ / "odd.json", s.dump());
+  const t::Output l = t::run(launch((dir_ / "odd.json").string()));
+  EXPECT_EQ(l.code, 0) << l.out;
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  const t::Output q = t::run(flocsim({"query", "--db", db_}));
+  for (const t::Output* o : {&l, &st, &q}) {
+    EXPECT_EQ(o->out.find('\x1b'), std::string::npos) << o->out;
+    EXPECT_EQ(o->out.find(rlo), std::string::npos) << o->out;
+  }
+  EXPECT_NE(l.out.find("label=red\\x1b[2J"), std::string::npos) << l.out;
+  EXPECT_NE(l.out.find("evil\\u202egpj.exe"), std::string::npos) << l.out;
+  EXPECT_NE(st.out.find("sweep n\\x1b[2Ja\\u202eme"), std::string::npos) << st.out;
+  EXPECT_NE(q.out.find("\\u202e"), std::string::npos) << q.out;
 }
 
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
@@ -604,6 +672,48 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
   EXPECT_NE(st.out.find("is read-only"), std::string::npos) << st.out;
   EXPECT_EQ(w.code, 1) << w.out;
   EXPECT_NE(w.out.find(ro_db + " is read-only"), std::string::npos) << w.out;
+}
+
+// Issue 41, item 20: `sweep cancel` refused a read-only database, though it
+// only reads the live attempts and signals their owners.
+TEST_F(Orchestrator, CancelReadsAReadOnlyDatabase) {
+  const fs::path rw = dir_ / "rw", ro = dir_ / "ro";
+  fs::create_directories(rw);
+  fs::create_directories(ro);
+  const std::string db = (rw / "results.db").string();
+  ASSERT_EQ(t::run(flocsim({"sweep", "launch", fake_sweep({1}, 1, 1), "--db", db, "--worker",
+                            FAKE_WORKER_EXE}))
+                .code,
+            0);
+  if (::geteuid() != 0 ||
+      std::system(("mount --bind " + rw.string() + " " + ro.string() +
+                   " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
+                      .c_str()) != 0) {
+    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+    GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
+  }
+  const t::Output c = t::run(flocsim({"sweep", "cancel", "--db", (ro / "results.db").string()}));
+  std::system(("umount " + ro.string()).c_str());
+  EXPECT_EQ(c.code, 0) << c.out;
+  EXPECT_NE(c.out.find("nothing is running"), std::string::npos) << c.out;
+}
+
+// Issue 41, item 12: `sweep plan --jobs 4096` built 4096 copies of the demo's
+// case to time them together (29 GB) before any memory check, and died of
+// std::bad_alloc under a memory limit. It now times as many as fit.
+TEST_F(Orchestrator, PlanWithMoreJobsThanMemoryHoldsTimesOneCopy) {
+  // the demo's case (about 7 MB) over 600 seeds, under a 2 GB address-space
+  // limit: 600 copies timed together would need about 4 GB
+  json s = t::read_json(FLOCSIM_SOURCE_DIR "/sweeps/demo.json");
+  json seeds = json::array();
+  for (int k = 1; k <= 600; ++k) seeds.push_back(k);
+  s["axes"] = {{"seed", seeds}};
+  t::write_text(dir_ / "many.json", s.dump());
+  const t::Output o =
+      t::run({"/usr/bin/prlimit", "--as=2000000000", FLOCSIM_EXE, "sweep", "plan",
+              (dir_ / "many.json").string(), "--jobs", "4096", "--measure-steps", "1"});
+  EXPECT_EQ(o.code, 0) << o.out.substr(0, 3000);
+  EXPECT_NE(o.out.find("600 runs"), std::string::npos) << o.out.substr(0, 3000);
 }
 
 // Issue 41, item 15: on a full file system `sweep status` and `resume` failed
