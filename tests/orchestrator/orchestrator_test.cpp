@@ -336,6 +336,33 @@ TEST_F(Orchestrator, AWorkerThatCannotStartIsRefusedBeforeAnyAttempt) {
   EXPECT_EQ(db.runs().front().attempts, 1);
 }
 
+// Issue 41, item 8: `sweep resume --backend slurm` trusted the Slurm settings
+// stored in the database: runs_per_task 0 wrote empty task files without end
+// (and ignored SIGTERM), a string for cpus_per_task gave a raw type_error.
+// They are checked as `sweep launch` checks them, before Slurm is asked.
+TEST_F(Orchestrator, StoredSlurmSettingsAreCheckedAsLaunchChecksThem) {
+  const std::string sweep = fake_sweep({1}, 1, 1, {{"exit", 1}}, 3);
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);
+  const json file = t::read_json(sweep);
+  for (const auto& [field, value, expect] :
+       {std::tuple<std::string, json, std::string>{"runs_per_task", 0, "slurm.runs_per_task = 0"},
+        {"cpus_per_task", "eight", "slurm.cpus_per_task"},
+        {"time_limit", "abc", "slurm.time_limit = \"abc\""}}) {
+    json stored = file;
+    stored["slurm"] = {{field, value}};
+    {
+      ResultsDb db(db_, ResultsDb::Mode::kExisting);
+      db.upsert_sweep("fake", stored.dump(), "[\"x\"]", 3);
+    }
+    const t::Output r = t::run({"/usr/bin/timeout", "20", FLOCSIM_EXE, "sweep", "resume", "--db",
+                                db_, "--backend", "slurm", "--worker", FAKE_WORKER_EXE});
+    EXPECT_EQ(r.code, 2) << field << ": " << r.out;
+    EXPECT_NE(r.out.find(expect), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("as stored"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "results.runs" / "slurm")) << "task files written";
+}
+
 // Issue 41, item 7: ESC sequences and U+202E in names and axis values reached
 // the terminal raw through launch, status and query.
 TEST_F(Orchestrator, ControlAndBidiCharactersAreShownEscaped) {
