@@ -1,5 +1,6 @@
 #include "db/results_db.hpp"
 
+#include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
@@ -260,6 +261,12 @@ void check_db_path(const std::string& path, ResultsDb::Mode mode) {
   if (::access(folder.c_str(), W_OK | X_OK) != 0)
     throw DbError("cannot create results database " + path + " in " + folder + ": " +
                   std::strerror(errno));
+  // made here, where the system says why it cannot be (a /proc folder passes
+  // the check above); SQLite takes an empty file as a new database
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0 && errno != EEXIST)
+    throw DbError("cannot create results database " + path + ": " + std::strerror(errno));
+  if (fd >= 0) ::close(fd);
 }
 
 // Whether the file system holding `path` has (next to) no room left for an

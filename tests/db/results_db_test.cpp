@@ -123,6 +123,12 @@ TEST_F(DbTest, PathsThatCannotHoldADatabaseAreNamedWithTheReason) {
       << error_of(under_file, ResultsDb::Mode::kExisting);
   EXPECT_NE(error_of(dir_.string(), ResultsDb::Mode::kCreate).find("is a directory"),
             std::string::npos);
+  // a folder that takes no files though it looks writable: the system's reason
+  const std::string in_proc = error_of("/proc/flocsim_test.sqlite", ResultsDb::Mode::kCreate);
+  EXPECT_EQ(in_proc.find("unable to open database file"), std::string::npos) << in_proc;
+  EXPECT_NE(in_proc.find("cannot create results database /proc/flocsim_test.sqlite: "),
+            std::string::npos)
+      << in_proc;
 }
 
 TEST_F(DbTest, RefusesMissingForeignAndNewerFiles) {
