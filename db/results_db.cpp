@@ -1,8 +1,12 @@
 #include "db/results_db.hpp"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -223,16 +227,62 @@ void refuse_non_sqlite_file(const std::string& path) {
                   "--db must name a results database written by `flocsim sweep launch`");
 }
 
+// Checks the path before SQLite sees it, with the operating system's reason:
+// SQLite says only "unable to open database file" (a file in the place of a
+// folder, a read-only folder, /proc), blames WAL for an empty path, and on a
+// device (/dev/null) says "disk I/O error" after leaving DEVICE-journal beside it.
+void check_db_path(const std::string& path, ResultsDb::Mode mode) {
+  namespace fs = std::filesystem;
+  if (path.empty())
+    throw DbError("--db \"\": an empty path; give a results database file (e.g. runs/demo.sqlite)");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode))
+      throw DbError(path + ": is a directory; --db must name a results database file");
+    if (!S_ISREG(st.st_mode))
+      throw DbError(path +
+                    ": not a regular file (a device, a pipe or a socket); --db must name a "
+                    "results database file");
+    return;
+  }
+  const int err = errno;
+  if (err != ENOENT || mode != ResultsDb::Mode::kCreate) {
+    if (err == ENOENT) return;  // said below, with what creates it
+    throw DbError("cannot open results database " + path + ": " + std::strerror(err));
+  }
+  // a new database may live in a folder that does not exist yet (runs/x.sqlite)
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) fs::create_directories(parent, ec);
+  if (ec)
+    throw DbError("cannot create results database " + path + ": its folder " + parent.string() +
+                  " cannot be made (" + ec.message() + ")");
+  const std::string folder = parent.empty() ? "." : parent.string();
+  if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    throw DbError("cannot create results database " + path + " in " + folder + ": " +
+                  std::strerror(errno));
+  // made here, where the system says why it cannot be (a /proc folder passes
+  // the check above); SQLite takes an empty file as a new database
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0 && errno != EEXIST)
+    throw DbError("cannot create results database " + path + ": " + std::strerror(errno));
+  if (fd >= 0) ::close(fd);
+}
+
+// Whether the file system holding `path` has (next to) no room left for an
+// unprivileged writer.
+bool file_system_full(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  struct statvfs fs {};
+  if (::statvfs(parent.empty() ? "." : parent.c_str(), &fs) != 0) return false;
+  return static_cast<double>(fs.f_bavail) * static_cast<double>(fs.f_frsize) < 64.0 * 1024;
+}
+
 }  // namespace
 
 ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pid_(getpid()) {
+  check_db_path(path, mode);
   refuse_non_sqlite_file(path);
-  if (mode == Mode::kCreate) {
-    // a new database may live in a folder that does not exist yet (runs/x.sqlite)
-    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    std::error_code ec;
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  }
   if (mode == Mode::kReadOnly) {
     open_read_only();
     return;
@@ -277,6 +327,12 @@ ResultsDb::ResultsDb(const std::string& path, Mode mode) : path_(path), owner_pi
     // a writable file in a read-only folder: WAL cannot make its -wal file
     if (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
       throw ReadOnlyDbError(read_only_message);
+    // a full file system: WAL cannot make its -shm index, and SQLite says
+    // "disk I/O error"; said as what it is, and readable as a read-only one
+    if ((code == SQLITE_FULL || (code & 0xff) == SQLITE_IOERR) && file_system_full(path))
+      throw DiskFullDbError("the file system under results database " + path +
+                            " is full, and this command writes to it: free some space; "
+                            "`flocsim query` and `flocsim sweep status` can still read it");
     throw DbError(std::string(e.what()).find(path) == std::string::npos
                       ? "results database " + path + ": " + e.what()
                       : std::string(e.what()));

@@ -35,6 +35,14 @@ class ReadOnlyDbError : public DbError {
   using DbError::DbError;
 };
 
+// A writer could not open a database because the file system under it is
+// full (SQLite says only "disk I/O error"). Like a read-only one, it can
+// still be read.
+class DiskFullDbError : public ReadOnlyDbError {
+ public:
+  using ReadOnlyDbError::ReadOnlyDbError;
+};
+
 inline constexpr int kSchemaVersion = 1;
 
 // Run and attempt states (RunState, with their stored text) are in

@@ -14,9 +14,11 @@
 #include <set>
 #include <thread>
 
+#include "engine/case/resolved_case.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/process/exit_codes.hpp"
 #include "engine/process/stop_signal.hpp"
+#include "engine/run/output_directory.hpp"
 #include "orchestrator/process.hpp"
 
 namespace flocsim::orchestrator {
@@ -115,10 +117,44 @@ void say(std::ostream* out, const std::string& line) {
   if (out) *out << line << std::endl;
 }
 
-// Records a result found complete on disk; returns whether it was valid.
-bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::RunRecord& run) {
+// DIR/result.json read as this run's result: complete, and of this run's case.
+// A result.json is only a file in a folder: one copied or left there by
+// another run (another seed, another sweep) must not become this run's result,
+// so its "case" is compared as `run --resume` compares it, with the case as
+// given (what a worker that copies it records) or as this version resolves it
+// (what `flocsim run` records).
+ResultRead read_own_result(const db::RunRecord& run) {
   ResultRead rr = read_result(run.run_dir, run.id);
-  if (!rr.record) return false;
+  if (!rr.record) return rr;
+  const json result = json::parse(rr.record->result_json, nullptr, false);
+  const json given = json::parse(run.case_json, nullptr, false);
+  const json recorded = result.is_object() ? result.value("case", json()) : json();
+  if (run::completed_under(recorded, given)) return rr;
+  json resolved = given;
+  try {
+    resolved = cases::resolved_case(given);
+    if (run::completed_under(recorded, resolved)) return rr;
+  } catch (const std::exception&) {
+    // this version refuses the case: only the case as given could have matched
+  }
+  const std::string field = recorded.is_object() ? first_difference(recorded, resolved) : "";
+  return {std::nullopt,
+          run.run_dir + "/result.json is the result of another case (" +
+              (field.empty() ? std::string("it records no case")
+                             : "first difference at case field " + field) +
+              "); it is not this run's result, so it is not recorded and is left as it is"};
+}
+
+// Records a result found complete on disk; returns whether it was valid.
+bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::RunRecord& run,
+                        std::ostream* out = nullptr) {
+  ResultRead rr = read_own_result(run);
+  if (!rr.record) {
+    // not an error yet (the worker may replace it), but never silent
+    if (out && rr.problem.find("another case") != std::string::npos)
+      *out << "not recorded " << run.id.substr(0, 12) << ": " << rr.problem << std::endl;
+    return false;
+  }
   db.record_result(attempt_id, *rr.record);
   return true;
 }
@@ -277,7 +313,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
       tried.push_back(run.id);
       fs::create_directories(run.run_dir);
       // A complete result already on disk (its recording was cut short): record, don't rerun.
-      if (record_if_complete(db, claim->attempt_id, run)) {
+      if (record_if_complete(db, claim->attempt_id, run, o.out)) {
         ++sum.recovered;
         say(o.out, progress_tag() + " recorded " + short_id(run.id) + " " +
                        point_text(run.point_json) + " (result.json found complete on disk)");
@@ -325,7 +361,7 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
   // Records how a worker ended.
   auto finish = [&](const Worker& w, std::optional<int> exit_code, std::optional<int> sig) {
     const std::string tag = short_id(w.run.id) + " " + point_text(w.run.point_json);
-    ResultRead rr = read_result(w.run.run_dir, w.run.id);
+    ResultRead rr = read_own_result(w.run);
     if (rr.record) {
       db.record_result(w.attempt_id, *rr.record);
       ++sum.completed;

@@ -1,5 +1,6 @@
 #include "orchestrator/plan.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -179,7 +180,9 @@ std::optional<double> slurm_time_limit_s(const std::string& limit) {
       const auto colon = s.find(':', start);
       const std::string p =
           s.substr(start, colon == std::string::npos ? std::string::npos : colon - start);
-      if (p.empty() || p.find_first_not_of("0123456789") != std::string::npos) return false;
+      // at most 9 digits: twenty overflowed std::stol ("error: stol")
+      if (p.empty() || p.size() > 9 || p.find_first_not_of("0123456789") != std::string::npos)
+        return false;
       parts.push_back(std::stol(p));
       if (colon == std::string::npos) return true;
       start = colon + 1;
@@ -187,7 +190,8 @@ std::optional<double> slurm_time_limit_s(const std::string& limit) {
   };
   if (dash != std::string::npos) {
     const std::string d = limit.substr(0, dash);
-    if (d.empty() || d.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+    if (d.empty() || d.size() > 9 || d.find_first_not_of("0123456789") != std::string::npos)
+      return std::nullopt;
     days = std::stol(d);
     rest = limit.substr(dash + 1);
     if (!parse_parts(rest) || parts.size() > 3) return std::nullopt;
@@ -258,9 +262,21 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
                     << std::flush;
       c.measured = run::measure_steps(first_case[i], o.measure_steps, o.measure_seconds);
       plan.memory_per_run_max = std::max(plan.memory_per_run_max, c.measured->memory_bytes);
-      // the workers share this machine: their rate is measured with as many at once
+      // the workers share this machine: their rate is measured with as many at
+      // once, where that many copies fit in memory (the one just measured says
+      // how much one takes): --jobs 4096 built 4096 copies to time them, 29 GB
+      // on a 23 GB machine, and died of bad_alloc. Where they do not fit, the
+      // one copy's rate is scaled by the sharing of the cores, and the plan
+      // says the runs at once need more memory than there is (below).
       const int together = std::min(o.jobs, plan.to_run);
-      if (o.backend == "local" && together > 1) {
+      double room = cases::physical_memory_bytes();
+      struct rlimit limit {};
+      if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+          (room <= 0 || static_cast<double>(limit.rlim_cur) < room))
+        room = static_cast<double>(limit.rlim_cur);
+      const bool fit = room <= 0 || c.measured->memory_bytes <= 0 ||
+                       (together + 1) * c.measured->memory_bytes <= 0.8 * room;
+      if (o.backend == "local" && together > 1 && fit) {
         c.measured_together =
             run::measure_steps(first_case[i], o.measure_steps, o.measure_seconds, together);
         c.copies_together = together;

@@ -249,8 +249,12 @@ std::optional<SweepEta> estimate_sweep_eta(const std::vector<double>& completed_
 namespace {
 
 // Columns padded to their widest cell, two spaces apart, indented.
-void write_columns(const std::vector<std::vector<std::string>>& rows, const std::string& indent,
+void write_columns(const std::vector<std::vector<std::string>>& given, const std::string& indent,
                    std::ostream& out) {
+  // as a terminal should show them: errors and points carry text from files
+  std::vector<std::vector<std::string>> rows = given;
+  for (auto& row : rows)
+    for (std::string& cell : row) cell = terminal_text(cell);
   auto width = [](const std::string& s) {
     std::size_t w = 0;
     for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;
@@ -304,7 +308,7 @@ bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
         if (a.state == RunState::kLost) was_lost = true, ++lost_attempts;
       if (was_lost && r.status == RunState::kCompleted) ++recovered;
     }
-    out << "sweep " << s.name << ": " << runs.size() << " runs:";
+    out << "sweep " << terminal_text(s.name) << ": " << runs.size() << " runs:";
     int lost_now = 0;
     for (const db::StateCount& c : db.count_states(s.id)) {
       if (c.status == RunState::kLost) lost_now = c.runs;
@@ -384,12 +388,13 @@ bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
       write_columns(stopped, "    ", out);
       if (retryable)
         out << "    retry the failed, lost and interrupted runs (from their checkpoints): "
-            << "flocsim sweep resume --db " << db.path() << " --sweep " << s.name << "\n";
+            << "flocsim sweep resume --db " << shell_word(db.path()) << " --sweep "
+            << shell_word(s.name) << "\n";
       if (exhausted_any)
         out << "    runs at the retry limit (max_attempts " << s.max_attempts
             << ") are not retried: raise max_attempts in the sweep file and launch it again "
                "(flocsim sweep launch SWEEP.json --db "
-            << db.path() << ")\n";
+            << shell_word(db.path()) << ")\n";
       if (refused_any)
         out << "    refused runs are not retried: change the case as the message says\n";
     }

@@ -5,10 +5,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -19,6 +21,7 @@
 #include "engine/process/stop_signal.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
+#include "orchestrator/sweep.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -69,6 +72,77 @@ void say(std::ostream* out, const std::string& line) {
   if (out) *out << line << std::endl;
 }
 
+// Where execvp would find `program` ("" when nowhere): run_program's -1 says
+// only that it could not run.
+std::string on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "/bin:/usr/bin");
+  for (std::string d; std::getline(dirs, d, ':');) {
+    const fs::path p = fs::path(d.empty() ? "." : d) / program;
+    if (access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+// A value of an sbatch --output pattern: there % starts a replacement (%a, %j,
+// %x), so a % of a folder's name must be written %% or the task's output goes
+// to a file that cannot be opened, and the task fails before it runs.
+std::string output_pattern(const std::string& path) {
+  std::string out;
+  for (char c : path) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
+// The job folder's name: the sweep name's first 40 characters that need no
+// quoting anywhere (others become _), then the time and this process: a long
+// or odd sweep name never makes a path too long or a pattern of it.
+std::string job_folder_name(const std::string& sweep) {
+  std::string part;
+  for (char c : sweep.substr(0, 40))
+    part +=
+        std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ? c : '_';
+  return part + "-" + std::to_string(static_cast<long long>(db::unix_now())) + "-" +
+         std::to_string(getpid());
+}
+
+// How the array tasks of a job that left the queue ended, from Slurm's own
+// record (scontrol while it remembers the job, MinJobAge; then sacct): task
+// id -> "STATE (exit CODE)". Empty when neither answers.
+std::map<std::string, std::string> task_states(const std::string& job_id) {
+  std::map<std::string, std::string> out;
+  std::string text;
+  if (run_program({"scontrol", "-o", "show", "job", job_id}, &text) == 0) {
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+      auto field = [&line](const std::string& key) {
+        const auto at = line.find(" " + key + "=");
+        if (at == std::string::npos) return std::string();
+        const auto from = at + key.size() + 2;
+        return line.substr(from, line.find(' ', from) - from);
+      };
+      const std::string task = field("ArrayTaskId"), state = field("JobState");
+      if (!state.empty())
+        out[task.empty() ? job_id : task] = state + " (exit " + field("ExitCode") + ")";
+    }
+    if (!out.empty()) return out;
+  }
+  if (run_program({"sacct", "-n", "-X", "-P", "-j", job_id, "-o", "JobID,State,ExitCode"}, &text) ==
+      0) {
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+      std::istringstream f(line);
+      std::string id, state, code;
+      std::getline(f, id, '|');
+      std::getline(f, state, '|');
+      std::getline(f, code, '|');
+      if (state.empty()) continue;
+      const auto us = id.find('_');
+      out[us == std::string::npos ? id : id.substr(us + 1)] = state + " (exit " + code + ")";
+    }
+  }
+  return out;
+}
+
 // Array task ids of a job still in the queue (pending, running, completing).
 std::set<std::string> queued_tasks(const std::string& job_id, bool* ok) {
   std::string text;
@@ -96,20 +170,36 @@ bool slurm_available(std::string* why) {
 
 SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const SlurmLaunch& l) {
   SlurmSummary sum;
+  // The Slurm settings as `sweep launch` checks them: the database is only a
+  // file, and a stored runs_per_task of 0 wrote empty task files without end.
+  SlurmOptions settings;
+  try {
+    settings = parse_sweep(nlohmann::ordered_json::parse(sweep.spec_json),
+                           db.path() + " (sweep " + sweep.name + " as stored)")
+                   .slurm;
+  } catch (const nlohmann::json::exception& e) {
+    throw flocsim::input::InputError(db.path() + ": the stored file of sweep " + sweep.name +
+                                     " is not JSON (" + e.what() +
+                                     "); launch its sweep file again");
+  }
+  const int per_task = settings.runs_per_task;
+  const int max_parallel = settings.max_parallel;
+  const std::string time_limit = settings.time_limit;
+  const std::string partition = settings.partition;
+  const int cpus = settings.cpus_per_task;
   std::string why;
   if (!slurm_available(&why))
     throw std::runtime_error("--backend slurm: Slurm is not reachable (" + why +
                              "); is SLURM_CONF set and slurmctld running?");
-  const nlohmann::json spec = nlohmann::json::parse(sweep.spec_json);
-  const nlohmann::json slurm = spec.value("slurm", nlohmann::json::object());
-  const int per_task = slurm.value("runs_per_task", 1);
-  const int max_parallel = slurm.value("max_parallel", 0);
-  const std::string time_limit = slurm.value("time_limit", std::string("01:00:00"));
-  const std::string partition = slurm.value("partition", std::string());
-  const int cpus = slurm.value("cpus_per_task", 1);
+  // said before anything is written: "sbatch failed (exit -1):" named no reason
+  if (on_path("sbatch").empty())
+    throw std::runtime_error(std::string("--backend slurm: sbatch is not on PATH (") +
+                             (std::getenv("PATH") ? std::getenv("PATH") : "unset") +
+                             "), though squeue answers; install Slurm's client commands "
+                             "(slurm-client) or add their folder to PATH");
   // a GPU per task when the workers run on cuda, unless the sweep says which
-  const std::string gres =
-      slurm.value("gres", std::string(l.device == "cuda" ? "gpu:1" : ""));
+  const std::string gres = !settings.gres.empty() ? settings.gres
+                                                  : (l.device == "cuda" ? "gpu:1" : "");
 
   // What to do: claimable runs of the sweep (the tasks claim them for real).
   std::vector<db::RunRecord> to_submit;
@@ -123,9 +213,7 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
     return sum;
   }
   const fs::path job_dir =
-      fs::path(to_submit.front().run_dir).parent_path() / "slurm" /
-      (sweep.name + "-" + std::to_string(static_cast<long long>(db::unix_now())) + "-" +
-       std::to_string(getpid()));
+      fs::path(to_submit.front().run_dir).parent_path() / "slurm" / job_folder_name(sweep.name);
   fs::create_directories(job_dir);
   int tasks = 0;
   for (std::size_t i = 0; i < to_submit.size(); i += static_cast<std::size_t>(per_task), ++tasks) {
@@ -138,31 +226,39 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
     std::ofstream(job_dir / ("task_" + std::to_string(tasks) + ".json")) << task.dump(2) << "\n";
   }
   const fs::path script = job_dir / "job.sh";
-  // a #SBATCH line ends at a line break: none may come from a path or a name
-  for (const std::string& v : {sweep.name, job_dir.string(), partition, time_limit, gres})
-    if (v.find_first_of("\n\r") != std::string::npos)
-      throw std::runtime_error("cannot write a Slurm job script with a line break in " +
-                               flocsim::input::shown(v));
+  // The options go to sbatch as its arguments, not as #SBATCH lines: sbatch
+  // reads those with rules of its own (a space ends the value, " must pair, #
+  // starts a comment), and a space in the runs folder or a " in the sweep name
+  // made it refuse the script. Arguments reach it as they are (no shell); only
+  // --output's % needs escaping. The job name is cut short: it only labels.
+  const std::vector<std::string> options = {
+      "--job-name=flocsim-" + sweep.name.substr(0, 64),
+      "--array=0-" + std::to_string(tasks - 1) +
+          (max_parallel > 0 ? "%" + std::to_string(max_parallel) : ""),
+      "--time=" + time_limit,
+      "--cpus-per-task=" + std::to_string(cpus),
+      "--ntasks=1",
+      "--output=" + output_pattern(job_dir.string()) + "/task_%a.out"};
+  std::vector<std::string> argv = {"sbatch", "--parsable"};
+  argv.insert(argv.end(), options.begin(), options.end());
+  if (!partition.empty()) argv.push_back("--partition=" + partition);
+  if (!gres.empty()) argv.push_back("--gres=" + gres);
+  argv.push_back(script.string());
   {
     std::ofstream f(script);
-    f << "#!/bin/sh\n"
-      << "#SBATCH --job-name=flocsim-" << sweep.name << "\n"
-      << "#SBATCH --array=0-" << tasks - 1
-      << (max_parallel > 0 ? "%" + std::to_string(max_parallel) : "") << "\n"
-      << "#SBATCH --time=" << time_limit << "\n"
-      << "#SBATCH --cpus-per-task=" << cpus << "\n"
-      << "#SBATCH --ntasks=1\n"
-      << "#SBATCH --output=" << (job_dir / "task_%a.out").string() << "\n"
-      << (partition.empty() ? "" : "#SBATCH --partition=" + partition + "\n")
-      << (gres.empty() ? "" : "#SBATCH --gres=" + gres + "\n") << "exec "
-      << shell_quote(l.flocsim) << " sweep slurm-task --db "
+    f << "#!/bin/sh\n# submitted by flocsim as:";
+    for (const std::string& a : argv) f << " " << shell_word(a);
+    f << "\nexec " << shell_quote(l.flocsim) << " sweep slurm-task --db "
       << shell_quote(fs::absolute(db.path()).string()) << " --sweep " << shell_quote(sweep.name)
       << " --task-file " << shell_quote((job_dir).string()) << "/task_${SLURM_ARRAY_TASK_ID}.json"
       << " --worker " << shell_quote(l.worker) << " --lease " << l.lease_s << "\n";
   }
   std::string text;
-  const int rc = run_program({"sbatch", "--parsable", script.string()}, &text);
-  if (rc != 0) throw std::runtime_error("sbatch failed (exit " + std::to_string(rc) + "): " + text);
+  const int rc = run_program(argv, &text);
+  if (rc != 0)
+    throw std::runtime_error(rc < 0 ? "sbatch (" + on_path("sbatch") + ") could not be run: " + text
+                                    : "sbatch refused the job (exit " + std::to_string(rc) +
+                                          "): " + text);
   sum.job_id = text.substr(0, text.find_first_of(";\n"));
   sum.tasks = tasks;
   sum.runs = static_cast<int>(to_submit.size());
@@ -204,7 +300,25 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
                      " ended before the run was recorded");
     }
   }
-  say(l.out, "slurm: job " + sum.job_id + " finished");
+  // Slurm's own word on how the tasks ended: a task that failed before it ran
+  // (its output file unwritable, the program missing) recorded nothing, and
+  // "finished" left its runs pending without a reason.
+  const std::map<std::string, std::string> states = task_states(sum.job_id);
+  std::string failed;
+  for (const auto& [task, state] : states)
+    if (state.rfind("COMPLETED", 0) != 0)
+      failed += (failed.empty() ? "" : "; ") + std::string("task ") + task + " " + state +
+                ", output " + (job_dir / ("task_" + task + ".out")).string();
+  if (states.empty())
+    say(l.out, "slurm: job " + sum.job_id + " left the queue (Slurm no longer says how it ended)");
+  else if (failed.empty())
+    say(l.out, "slurm: job " + sum.job_id + " finished");
+  else {
+    sum.failed_tasks = failed;
+    say(l.out, "slurm: job " + sum.job_id + " ended with Slurm's failure: " + failed +
+                   "; runs its tasks did not record stay as they were (sweep status lists "
+                   "them)");
+  }
   return sum;
 }
 

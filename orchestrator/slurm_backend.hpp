@@ -32,6 +32,8 @@ struct SlurmSummary {
   int tasks = 0, runs = 0;
   int lost = 0;  // runs left running by a job that ended
   bool stopped = false;
+  // Tasks that Slurm says did not complete: "task N STATE (exit C), output F; ..."
+  std::string failed_tasks;
 };
 
 // True when sbatch and squeue can be run and answer.

@@ -3,11 +3,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include "engine/input/input_reader.hpp"
+#include "orchestrator/plan.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -204,6 +207,14 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
                                   "0123456789:-_.,") != std::string::npos)
         throw InputError(field + " = " + flocsim::input::shown(value) +
                          ": must be one word of letters, digits and : - _ . , (Slurm's syntax)");
+    // read here, when the sweep is read: "abc" went to sbatch after the sweep
+    // was registered, twenty digits stopped the plan with "error: stol"
+    if (!slurm_time_limit_s(s.slurm.time_limit) && s.slurm.time_limit != "UNLIMITED" &&
+        s.slurm.time_limit != "INFINITE")
+      throw InputError("slurm.time_limit = " + flocsim::input::shown(s.slurm.time_limit) +
+                       ": not a Slurm time limit; allowed: MINUTES, MINUTES:SECONDS, "
+                       "HOURS:MINUTES:SECONDS, DAYS-HOURS, DAYS-HOURS:MINUTES, "
+                       "DAYS-HOURS:MINUTES:SECONDS (numbers of at most 9 digits) or UNLIMITED");
     s.slurm.max_parallel =
         static_cast<int>(slurm.integer("max_parallel", {.at_least = 0, .at_most = 100000}, 0));
     s.slurm.cpus_per_task =
@@ -270,7 +281,23 @@ SweepSpec read_sweep_file(const std::string& filename) {
     throw InputError(std::string("sweep file ") + e.what());
   }
   flocsim::input::check_json_text(text, "sweep file " + filename);
-  return parse_sweep(nlohmann::ordered_json::parse(text), filename);
+  nlohmann::ordered_json file = nlohmann::ordered_json::parse(text);
+  // A relative positions_from names a file beside the sweep file, not in
+  // whatever folder the sweep is launched (or resumed, or run by Slurm) from:
+  // it is made absolute here, so that the stored case names one file.
+  const std::filesystem::path folder = std::filesystem::absolute(filename).parent_path();
+  auto anchor = [&folder](nlohmann::ordered_json& v) {
+    if (!v.is_string() || v.get<std::string>().empty()) return;
+    const std::filesystem::path p(v.get<std::string>());
+    if (p.is_relative()) v = (folder / p).lexically_normal().string();
+  };
+  if (file.is_object() && file.contains("base") && file["base"].is_object() &&
+      file["base"].contains("positions_from"))
+    anchor(file["base"]["positions_from"]);
+  if (file.is_object() && file.contains("axes") && file["axes"].is_object() &&
+      file["axes"].contains("positions_from") && file["axes"]["positions_from"].is_array())
+    for (auto& v : file["axes"]["positions_from"]) anchor(v);
+  return parse_sweep(file, filename);
 }
 
 std::vector<RunPoint> expand(const SweepSpec& sweep) {
@@ -307,12 +334,22 @@ std::vector<RunPoint> expand(const SweepSpec& sweep) {
 std::string point_text(const std::string& point_json) {
   if (point_json.empty()) return "";
   const auto p = nlohmann::ordered_json::parse(point_json, nullptr, false);
-  if (!p.is_object()) return point_json;
+  if (!p.is_object()) return terminal_text(point_json);
   std::string out;
   for (auto it = p.begin(); it != p.end(); ++it)
     out += (out.empty() ? "" : " ") + it.key() + "=" +
            (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
-  return out;
+  return terminal_text(out);  // for terminals: a value's ESC or U+202E is shown, not obeyed
+}
+
+std::string shell_word(const std::string& word) {
+  const bool plain = !word.empty() && word.find_first_not_of(
+                                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                          "0123456789-_./:,+=@") == std::string::npos;
+  if (plain) return word;
+  std::string out = "'";
+  for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
 }
 
 }  // namespace flocsim::orchestrator

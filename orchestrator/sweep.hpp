@@ -48,7 +48,7 @@ struct SlurmOptions {
   std::string partition;
   int max_parallel = 0;  // array throttle (%k); 0 = no throttle
   int cpus_per_task = 1;
-  // generic resources per task (#SBATCH --gres); empty: "gpu:1" when the
+  // generic resources per task (sbatch --gres); empty: "gpu:1" when the
   // sweep runs on cuda, none otherwise
   std::string gres;
 };
@@ -82,5 +82,11 @@ inline constexpr std::size_t kMaxRunsPerSweep = 100000;
 // A grid point as a user reads it: "Re_inf=6 du_over_Uinf=0.03" (its JSON text
 // when it is not an object).
 std::string point_text(const std::string& point_json);
+
+// `word` as one word of a POSIX shell command a user may paste (the commands
+// flocsim suggests): as it is when it holds only letters, digits and
+// - _ . / : , + = @, single-quoted otherwise, so that no name or path runs as
+// a command ("$(touch X)" stays text).
+std::string shell_word(const std::string& word);
 
 }  // namespace flocsim::orchestrator

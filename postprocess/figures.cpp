@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "engine/observables/reference_correlations.hpp"
+#include "engine/output/atomic_file.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "postprocess/paper_values.hpp"
 
@@ -86,7 +87,8 @@ class Plot {
   std::string data(const std::string& tag, const std::string& rows) {
     fs::create_directories(dir_ / "data");
     const std::string file = file_part(name_ + (tag.empty() ? "" : "_" + tag)) + ".dat";
-    std::ofstream(dir_ / "data" / file) << rows;
+    // by rename, never through a symbolic link left in the folder
+    output::write_file_atomically(dir_ / "data" / file, rows);
     return "'data/" + file + "'";
   }
   std::ostringstream& commands() { return commands_; }
@@ -113,14 +115,14 @@ class Plot {
     // The commands once per terminal, from a reset state, not replot: gnuplot 5.4's replot
     // after a multiplot redraws only its last panel.
     // (run in the figures folder: `cd figures && gnuplot scripts/NAME.gp` redraws)
-    std::ofstream(script) << "set terminal pngcairo size " << size_png
-                          << " enhanced font 'sans,11'\nset output '" << f.png.filename().string()
-                          << "'\n"
-                          << offsets << commands_.str() << "\nunset output\nreset\n"
-                          << "set terminal pdfcairo size " << size_pdf
-                          << " enhanced font 'sans,9'\nset output '" << f.pdf.filename().string()
-                          << "'\n"
-                          << offsets << commands_.str() << "\nunset output\n";
+    std::ostringstream text;
+    text << "set terminal pngcairo size " << size_png << " enhanced font 'sans,11'\nset output '"
+         << f.png.filename().string() << "'\n"
+         << offsets << commands_.str() << "\nunset output\nreset\n"
+         << "set terminal pdfcairo size " << size_pdf << " enhanced font 'sans,9'\nset output '"
+         << f.pdf.filename().string() << "'\n"
+         << offsets << commands_.str() << "\nunset output\n";
+    output::write_file_atomically(script, text.str());
     const fs::path log = dir_ / "scripts" / (name_ + ".log");
     if (run_gnuplot(dir_, "scripts/" + name_ + ".gp", log) != 0)
       throw std::runtime_error("gnuplot failed on figure " + name_ + "; see " + log.string());
@@ -140,10 +142,18 @@ struct Series {
       phi_x;
   std::size_t slabs = 0;
 };
-Series read_series(const RunSummary& r) {
+// `problem`: why there is none ("" when the file was read).
+Series read_series(const RunSummary& r, std::string* problem) {
   Series s;
   const fs::path file = fs::path(r.run_dir) / "series.h5";
-  if (r.run_dir.empty() || !fs::exists(file)) return s;
+  if (r.run_dir.empty()) {
+    *problem = "the database records no folder for it";
+    return s;
+  }
+  if (!fs::exists(file)) {
+    *problem = file.string() + " is missing";
+    return s;
+  }
   try {
     const output::Hdf5File f(file, output::Hdf5File::Mode::read);
     auto read = [&](const std::string& name, std::vector<double>& into) {
@@ -163,9 +173,12 @@ Series read_series(const RunSummary& r) {
       s.phi_x = f.read<double>("/phi_x", &shape);
       if (shape.size() == 2) s.slabs = shape[1];
     }
-  } catch (const std::exception&) {
-    return Series{};  // a truncated file of a running run: no series yet
+  } catch (const std::exception& e) {
+    // a truncated file of a running run: no series yet (said only of completed runs)
+    *problem = file.string() + " cannot be read (" + e.what() + ")";
+    return Series{};
   }
+  if (s.time.empty()) *problem = file.string() + " holds no time series (/time)";
   return s;
 }
 
@@ -271,8 +284,20 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
   // ---- per (phi, Re_inf): time series, p(n_a), g(r), h(theta) (Figs. 5, 7, 9, 2) ----
   std::map<std::pair<double, double>, std::vector<std::pair<const RunSummary*, Series>>> groups;
   for (const RunSummary& r : runs) {
-    Series s = read_series(r);
-    if (!s.time.empty()) groups[{r.phi, r.re_inf}].push_back({&r, std::move(s)});
+    std::string problem;
+    Series s = read_series(r, &problem);
+    if (!s.time.empty()) {
+      groups[{r.phi, r.re_inf}].push_back({&r, std::move(s)});
+    } else if (r.status == db::RunState::kCompleted) {
+      // a completed run the tables list but these figures cannot draw: never
+      // left out without a word (a running run simply has no series yet)
+      const std::string tag = label(r.phi, r.re_inf);
+      set.runs_left_out.push_back(
+          "run " + r.id.substr(0, 12) + " (phi = " + num(r.phi) + ", Re_inf = " + num(r.re_inf) +
+          ", du/U_inf = " + num(r.du) + "): " + problem + "; it is missing from the figures " +
+          "timeseries_" + tag + ", size_distribution_" + tag + ", pair_structure_" + tag +
+          " and spacetime_" + tag + "_du" + num(r.du));
+    }
   }
   if (groups.empty())
     set.skipped.push_back("time series, p(n_a), g(r), h(theta), phi(x,t): no series.h5 found");

@@ -23,6 +23,9 @@ struct Figure {
 struct FigureSet {
   std::vector<Figure> figures;
   std::vector<std::string> skipped;  // "name: reason"
+  // Completed runs left out of the figures drawn from series.h5: the run, the
+  // file, the reason and the figures it is missing from.
+  std::vector<std::string> runs_left_out;
 };
 
 // Why no figure can be drawn here (gnuplot is not on PATH), empty when they can.

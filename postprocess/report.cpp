@@ -428,6 +428,8 @@ void write_report(const std::vector<RunSummary>& runs, const FigureSet& figures,
       << escape(f.pdf.filename().string()) << "</code>.</figcaption></figure>\n";
   }
   for (const std::string& s : figures.skipped) h << "<p>Not drawn: " << escape(s) << "</p>\n";
+  for (const std::string& s : figures.runs_left_out)
+    h << "<p>Left out of figures: " << escape(s) << "</p>\n";
 
   h << "<h2 id='runs'>Runs and provenance</h2>\n";
   HtmlTable t;

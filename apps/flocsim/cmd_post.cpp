@@ -9,6 +9,7 @@
 #include "apps/flocsim/command_registry.hpp"
 #include "db/results_db.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/output/atomic_file.hpp"
 #include "orchestrator/terminal_table.hpp"
 #include "postprocess/figures.hpp"
 #include "postprocess/report.hpp"
@@ -26,10 +27,55 @@ struct PostOptions {
   bool all = false;
 };
 
+// By a temporary file and a rename: a file replaced this way is never written
+// through (an ofstream follows a symbolic link and overwrites its target).
 void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream f(p);
-  f << text;
-  if (!f) throw std::runtime_error("cannot write " + p.string());
+  output::write_file_atomically(p, text);
+}
+
+// Refuses, before any work, an --out folder in which a file or folder that
+// post writes is a symbolic link: post would write through it and overwrite
+// the link's target (gnuplot writes the figures itself, so a rename cannot
+// help there). The links are the user's: named, never removed.
+void refuse_links(const fs::path& out) {
+  auto is_link = [](const fs::path& p) {
+    std::error_code ec;
+    return fs::is_symlink(fs::symlink_status(p, ec));
+  };
+  auto ends_with = [](const std::string& name, const std::string& tail) {
+    return name.size() >= tail.size() &&
+           name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  std::vector<std::string> links;
+  for (const char* name : {"aggregation.csv", "aggregation.md", "aggregation.tex",
+                           "non_aggregating.csv", "non_aggregating.md", "non_aggregating.tex",
+                           "columns.md", "left_out.md", "report.html", "figures"})
+    if (is_link(out / name)) links.push_back((out / name).string());
+  // what the figures folder holds: PNG, PDF, data/*.dat, scripts/*.gp and their logs
+  const std::vector<std::pair<std::string, std::vector<std::string>>> folders = {
+      {"figures", {".png", ".pdf"}},
+      {"figures/data", {".dat"}},
+      {"figures/scripts", {".gp", ".log"}}};
+  for (const auto& [folder, tails] : folders) {
+    const fs::path f = out / folder;
+    std::error_code ec;
+    if (folder != "figures" && is_link(f)) links.push_back(f.string());
+    if (is_link(f) || !fs::is_directory(f, ec)) continue;
+    for (const auto& e : fs::directory_iterator(f, ec)) {
+      const std::string name = e.path().filename().string();
+      if (!is_link(e.path())) continue;
+      for (const std::string& tail : tails)
+        if (ends_with(name, tail)) links.push_back(e.path().string());
+    }
+  }
+  if (links.empty()) return;
+  std::string list;
+  for (const auto& l : links) list += (list.empty() ? "" : ", ") + l;
+  throw input::InputError("--out " + out.string() + ": " + list +
+                          (links.size() > 1 ? " are symbolic links" : " is a symbolic link") +
+                          " where flocsim post writes its output, which would overwrite what " +
+                          (links.size() > 1 ? "they point" : "it points") +
+                          " to; remove the link (flocsim does not) or use another --out folder");
 }
 
 // Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table:
@@ -75,6 +121,13 @@ int post(const std::string& what, const PostOptions& o) {
   try {
     std::vector<orchestrator::Filter> where;
     for (const std::string& w : o.where) where.push_back(orchestrator::parse_filter(w));
+    // every option is checked before any work: --columns named an unknown
+    // column only after every figure and table was written, and no report
+    if (what != "figures") {
+      std::ostringstream unused;
+      pp::write_aggregation_terminal({}, o.columns, o.all, 0, unused);
+    }
+    refuse_links(fs::path(o.out_dir));
     // said before any work: without gnuplot there are no figures
     const std::string no_figures = what == "tables" ? "" : pp::why_no_figures();
     if (!no_figures.empty()) {
@@ -103,6 +156,8 @@ int post(const std::string& what, const PostOptions& o) {
       if (what == "figures")
         for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
       for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
+      for (const auto& s : figures.runs_left_out)
+        std::cerr << "flocsim post: left out of figures: " << s << "\n";
       if (what == "report") {
         write_tables(runs, left_out, out, o);
         pp::write_report(runs, figures, o.db_path, out / "report.html", left_out);

@@ -3,7 +3,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
@@ -23,6 +25,7 @@
 #include "orchestrator/report.hpp"
 #include "orchestrator/slurm_backend.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::app {
 namespace {
@@ -53,6 +56,40 @@ std::string default_worker() {
       "cannot find the flocsim executable to run as the worker; give --worker PATH");
 }
 
+// Refuses a --worker that cannot be started, before any run is claimed: a
+// missing one failed every run with exit 127, naming no path, and each
+// failure used up one of the run's attempts.
+void check_worker(const std::string& worker) {
+  if (worker.empty()) return;  // this flocsim
+  std::string found;
+  if (worker.find('/') != std::string::npos) {
+    found = worker;
+  } else {
+    const char* path = std::getenv("PATH");
+    std::istringstream dirs(path ? path : "/bin:/usr/bin");
+    for (std::string d; std::getline(dirs, d, ':') && found.empty();) {
+      const std::filesystem::path p = std::filesystem::path(d.empty() ? "." : d) / worker;
+      if (access(p.c_str(), X_OK) == 0 && !std::filesystem::is_directory(p)) found = p.string();
+    }
+    if (found.empty())
+      throw flocsim::input::InputError("--worker " + worker + ": not found on PATH (" +
+                                       (path ? path : "unset") +
+                                       "); give the worker program's path");
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(found, ec))
+    throw flocsim::input::InputError("--worker " + worker + ": no such file" +
+                                     (ec ? " (" + ec.message() + ")" : std::string()) +
+                                     "; give the path of a program run as `WORKER run CASE "
+                                     "--out DIR` (default: this flocsim)");
+  if (std::filesystem::is_directory(found, ec))
+    throw flocsim::input::InputError("--worker " + worker +
+                                     ": is a directory; give the worker program's path");
+  if (access(found.c_str(), X_OK) != 0)
+    throw flocsim::input::InputError("--worker " + worker + ": cannot be run (" +
+                                     std::strerror(errno) + "); allowed: an executable file");
+}
+
 int exit_code_for(db::ResultsDb& db, const db::SweepRecord& sweep, bool stopped) {
   if (stopped) return kExitInterrupted;
   for (const db::StateCount& c : db.count_states(sweep.id))
@@ -72,8 +109,9 @@ void print_summary(const orc::PoolSummary& s, db::ResultsDb& db, const db::Sweep
         c.runs > 0)
       restartable = true;
   if (restartable)
-    std::cout << "restart what did not finish with: flocsim sweep resume --db " << db.path()
-              << " --sweep " << sweep.name << "\n";
+    // quoted: the line is made to be pasted, and a name or path must stay text
+    std::cout << "restart what did not finish with: flocsim sweep resume --db "
+              << orc::shell_word(db.path()) << " --sweep " << orc::shell_word(sweep.name) << "\n";
 }
 
 db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
@@ -285,6 +323,7 @@ const bool registered = register_command(
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
              // a grid refused here leaves no database file behind
              const int gpus = check_device(*o, orc::expand(spec));
+             check_worker(o->worker);
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
              if (o->worker.empty() && !std::getenv("FLOCSIM_WORKER")) {
                // what it will cost, on one screen, before anything starts (asks
@@ -300,14 +339,15 @@ const bool registered = register_command(
              const std::string runs_dir =
                  o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
              const orc::Registered reg = orc::register_sweep(db, spec, runs_dir);
-             std::cout << "sweep " << spec.name << ": " << reg.runs << " runs (" << reg.added.added
-                       << " new, " << reg.added.reused << " already in " << o->db_path
-                       << "); run folders under " << std::filesystem::absolute(runs_dir).string()
-                       << "\n";
+             std::cout << "sweep " << orc::terminal_text(spec.name) << ": " << reg.runs << " runs ("
+                       << reg.added.added << " new, " << reg.added.reused << " already in "
+                       << o->db_path << "); run folders under "
+                       << std::filesystem::absolute(runs_dir).string() << "\n";
              return run_sweep(*o, db, reg.sweep,
                               {RunState::kPending, RunState::kInterrupted, RunState::kLost}, gpus);
            }
            if (*action == "resume") {
+             check_worker(o->worker);
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
@@ -332,12 +372,14 @@ const bool registered = register_command(
              try {
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kExisting);
                orc::reconcile_lost_workers(*opened, o->lease_s, &std::cout);
-             } catch (const db::ReadOnlyDbError&) {
+             } catch (const db::ReadOnlyDbError& e) {
                writable = false;
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
                std::cout << o->db_path
-                         << " is read-only: shown as recorded (workers that died are not "
-                            "marked lost)\n";
+                         << (dynamic_cast<const db::DiskFullDbError*>(&e)
+                                 ? ": the file system under it is full (free some space)"
+                                 : " is read-only")
+                         << ": shown as recorded (workers that died are not marked lost)\n";
              }
              db::ResultsDb& db = *opened;
              const std::optional<std::string> which =
@@ -349,8 +391,15 @@ const bool registered = register_command(
              return watch_status(db, writable, which, o->watch_s, o->lease_s);
            }
            if (*action == "cancel") {
-             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
-             return orc::cancel_all(db, std::cout) >= 0 ? kExitOk : kExitFailure;
+             // cancel only reads the live attempts and signals their owners (or
+             // scancels their jobs): a read-only database is read as it is
+             std::unique_ptr<db::ResultsDb> opened;
+             try {
+               opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kExisting);
+             } catch (const db::ReadOnlyDbError&) {
+               opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
+             }
+             return orc::cancel_all(*opened, std::cout) >= 0 ? kExitOk : kExitFailure;
            }
            if (*action == "slurm-task") {
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);

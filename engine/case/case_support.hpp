@@ -15,6 +15,22 @@ inline std::string format_value(double v) {
   return s.str();
 }
 
+// A number exactly as given (the shortest text that reads back as the same
+// double): for refusals at a boundary, where 6 digits would print a refused
+// value as an accepted one.
+inline std::string exact_value(double v) {
+  for (int digits = 6; digits < 17; ++digits) {
+    std::ostringstream s;
+    s.precision(digits);
+    s << v;
+    if (std::stod(s.str()) == v) return s.str();
+  }
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
 // Physical memory of this machine in bytes (0 when the system does not say).
 inline double physical_memory_bytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);

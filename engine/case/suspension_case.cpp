@@ -101,10 +101,14 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
       throw InputError(
           "numerics.immersed_boundary.marker_spacing = " + format_value(scheme.marker_spacing) +
           " with control forcing: " + coupling::dense_control_markers_why());
-    if (ib.has("sweeps") && ib.integer("sweeps", {.at_least = 1, .at_most = 1}) != 1)
-      throw InputError(
-          "numerics.immersed_boundary.sweeps: control forcing makes one correction "
-          "per step (1)");
+    // said as the reason, not as a range: "must be >= 1 and <= 1" hid why
+    if (ib.has("sweeps")) {
+      const long n = ib.integer("sweeps", {.at_least = 1, .at_most = 20});
+      if (n != 1)
+        throw InputError("numerics.immersed_boundary.sweeps = " + std::to_string(n) +
+                         ": control forcing makes one correction a step, so sweeps must be 1 "
+                         "(or left out)");
+    }
     scheme.sweeps = 1;
     scheme.gains = coupling::kControlScheme.gains;
     if (ib.has("gains")) {
@@ -114,9 +118,11 @@ coupling::Scheme read_coupling(InputReader& numerics, const coupling::Scheme& pr
       scheme.gains.proportional =
           g.number("proportional", {.at_least = 0, .at_most = 100}, scheme.gains.proportional);
       if (!coupling::stable_gains(scheme.gains))
+        // the values as given (shortest round trip): rounded, (1, 1.0000001)
+        // read "{integral 1, proportional 1}", which the region holds
         throw InputError("numerics.immersed_boundary.gains = {integral " +
-                         format_value(scheme.gains.integral) + ", proportional " +
-                         format_value(scheme.gains.proportional) +
+                         exact_value(scheme.gains.integral) + ", proportional " +
+                         exact_value(scheme.gains.proportional) +
                          "}: " + coupling::stable_gains_region());
       g.finish();
     }
@@ -382,6 +388,23 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     c.derived.settling_velocity =
         num.number("U_inf", u_range, liquid ? p.settling_velocity : kSettlingVelocityWithoutLiquid);
     c.numerics.viscosity = c.derived.settling_velocity * 2 * a / c.physics.reynolds_inf;
+    // The ceiling of a viscosity given directly holds for one implied by U_inf:
+    // nu = 2 a U_inf / Re_inf has no upper bound as Re_inf falls (Re_inf 0.01
+    // at draft: nu 56), and such runs blew up with hints that the viscosity
+    // was too small. Refused before any work, with the U_inf that keeps nu in range.
+    constexpr double kLargestViscosity = 1;  // numerics.viscosity's own limit (above)
+    if (liquid && c.numerics.viscosity > kLargestViscosity) {
+      const double u_works = c.physics.reynolds_inf * kLargestViscosity / (2 * a);
+      throw InputError("Re_inf = " + format_value(c.physics.reynolds_inf) +
+                       " with numerics.U_inf = " + format_value(c.derived.settling_velocity) +
+                       (has_u ? "" : " (the " + c.fidelity + " preset's)") + " and a_over_dx = " +
+                       format_value(a) + " implies numerics.viscosity = 2 a U_inf / Re_inf = " +
+                       format_value(c.numerics.viscosity) + ", above the largest accepted (" +
+                       format_value(kLargestViscosity) +
+                       "); give numerics.U_inf <= " + format_value(u_works) +
+                       " (or numerics.viscosity <= " + format_value(kLargestViscosity) +
+                       "), or a larger Re_inf");
+    }
     // by default stay inside the stable viscosity range: raise U_inf instead
     if (!has_u && c.numerics.viscosity < nu_min) {
       c.numerics.viscosity = nu_min;
@@ -425,6 +448,16 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       return read_coupling(num, preset_scheme);
     };
     c.numerics.coupling = choose_scheme();
+    // A scene without liquid couples nothing: the options are read (and
+    // checked) but no scheme runs and none is recorded, as for the
+    // lubrication options of a scene without lubrication; said, not silent.
+    if (!modules_of(c.scene).liquid)
+      for (const char* key : {"coupling", "immersed_boundary"})
+        if (num.has(key))
+          c.warnings.push_back(std::string("numerics.") + key + ": scene \"" +
+                               std::string(scene_name(c.scene)) +
+                               "\" has no liquid, so no coupling runs; not recorded (leave it out: "
+                               "in a sweep it still changes the run's id)");
     // By default also stay clear of the multi-sweep coupling's oscillation
     // (below): raise U_inf until nu reaches its floor, where the Mach limit
     // allows, and choose again at that viscosity.

@@ -118,7 +118,15 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   Baseline base;
   const fs::path& checkpoint = shell.checkpoint_file();
   if (shell.resuming()) {
-    read_checkpoint(checkpoint, fluid, c, base);
+    // a checkpoint of another case is an input error of its own; any other
+    // failure to read it means the file is damaged: say what to do with it
+    try {
+      read_checkpoint(checkpoint, fluid, c, base);
+    } catch (const input::InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      damaged_checkpoint(checkpoint, e.what());
+    }
     log.info("resumed from " + checkpoint.string() + " at step " +
              std::to_string(fluid.time_step()));
   } else {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <ctime>
 #include <fstream>
+#include <iostream>
 #include <set>
 
 #include "engine/case/scene.hpp"
@@ -103,6 +104,40 @@ StartMode prepare_output_directory(const fs::path& dir, bool resume,
 }
 
 namespace {
+// Where an unreadable result.json is set aside (free_name adds .1, .2, ...).
+constexpr const char* kUnreadableResult = "result.json.unreadable";
+
+// Why a result.json is not a completed result ("" when it is one).
+std::string damaged_result(const fs::path& file) {
+  try {
+    std::ifstream in(file);
+    const auto j = nlohmann::json::parse(in);
+    if (!j.is_object() || !j.contains("status") || j["status"] != "completed")
+      return "holds no completed result (no \"status\": \"completed\")";
+    return "";
+  } catch (const std::exception&) {
+    return "cannot be read as JSON (cut short?)";
+  }
+}
+
+// Whether the run record in `dir` names this case.
+bool recorded_as(const fs::path& dir, const nlohmann::json& case_json) {
+  try {
+    std::ifstream in(dir / kRunRecord);
+    return resumable_under(nlohmann::json::parse(in).at("case"), case_json);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// `path`, or path.1, path.2, ... : the first name not taken.
+fs::path free_name(const fs::path& path) {
+  fs::path p = path;
+  for (int k = 1; fs::exists(fs::symlink_status(p)); ++k)
+    p = fs::path(path.string() + "." + std::to_string(k));
+  return p;
+}
+
 StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_json) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
@@ -110,8 +145,36 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
                             ": exists and is not a directory; --out must name a "
                             "directory");
   fs::create_directories(dir);
-  const bool completed = fs::exists(dir / "result.json");
+  bool completed = fs::exists(dir / "result.json");
   const bool checkpoint = fs::exists(dir / "checkpoint.h5");
+  if (completed) {
+    // A run writes result.json last and atomically, so one that cannot be read
+    // was cut short by something else (a full disk, a copy): it completes
+    // nothing. Under --resume it is set aside (renamed, never removed) and the
+    // run goes on from its checkpoint or starts again; said "already
+    // completed" and then failing on it, the run could never be resumed.
+    const std::string damage = damaged_result(dir / "result.json");
+    if (!damage.empty()) {
+      if (!resume)
+        throw input::InputError((dir / "result.json").string() + ": " + damage +
+                                "; continue this case with --resume (the file is set aside as " +
+                                kUnreadableResult + "), or use another --out directory");
+      if (!checkpoint && !recorded_as(dir, case_json))
+        throw input::InputError(
+            (dir / "result.json").string() + ": " + damage + ", and neither a checkpoint nor " +
+            (dir / kRunRecord).string() +
+            " says this case wrote it; move it away to run this case here, or use another "
+            "--out directory");
+      const fs::path aside = free_name(dir / kUnreadableResult);
+      fs::rename(dir / "result.json", aside);
+      const std::string note = (dir / "result.json").string() + ": " + damage + "; set aside as " +
+                               aside.string() + ", the run " +
+                               (checkpoint ? "continues from its checkpoint" : "starts again");
+      RunLog(dir / "run.log", true).warning(note);
+      std::cerr << "flocsim run: warning: " << note << "\n";
+      completed = false;
+    }
+  }
   if (completed) {
     if (resume) {
       // "already completed" only for the case it completed: another case's
@@ -283,6 +346,13 @@ RunReport blown_up_run(RunLog& log, const std::string& where, const std::string&
               "Likely causes: " + likely_causes + ".";
   log.error(r.message);
   return r;
+}
+
+void damaged_checkpoint(const std::filesystem::path& checkpoint, const std::string& why) {
+  throw std::runtime_error(
+      checkpoint.string() + " cannot be read (" + why +
+      "): it is damaged, so this run cannot continue from it. Move it away (flocsim removes "
+      "nothing it cannot prove it wrote) and run again with --resume to start this case over");
 }
 
 void require_resumable(const std::filesystem::path& checkpoint, const nlohmann::json& recorded_case,

@@ -2,7 +2,9 @@
 // What a run finds in its output directory decides how it starts:
 //   - result.json present: the run is complete; --resume of the same case
 //     leaves it alone (of another case: refused, naming the fields that
-//     differ), a fresh start refuses to overwrite it;
+//     differ), a fresh start refuses to overwrite it; one that cannot be read
+//     completes nothing: --resume sets it aside (result.json.unreadable) and
+//     goes on from the checkpoint or starts again;
 //   - checkpoint.h5 present: --resume continues from it, a fresh start
 //     refuses (it would silently discard the work);
 //   - otherwise a fresh start. A run removes only files it can prove it
@@ -62,6 +64,10 @@ bool completed_under(const nlohmann::json& result_case, const nlohmann::json& cu
 // checkpoint, new now" for each differing field, joined by "; ".
 std::string case_differences(const nlohmann::json& checkpoint_case,
                              const nlohmann::json& current_case);
+// Throws the failure of a checkpoint that cannot be read (`why`): it names the
+// file and the way out (move it away, --resume starts the case over).
+[[noreturn]] void damaged_checkpoint(const std::filesystem::path& checkpoint,
+                                     const std::string& why);
 // Throws input::InputError naming the checkpoint file and the differing
 // fields unless the checkpoint's case is resumable under the current one.
 void require_resumable(const std::filesystem::path& checkpoint, const nlohmann::json& recorded_case,

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <random>
 
+#include "engine/input/input_reader.hpp"
 #include "engine/observables/aggregates.hpp"
 #include "engine/observables/liquid_averages.hpp"
 #include "engine/observables/pair_structure.hpp"
@@ -186,7 +187,15 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   const int slabs = phi_slabs(c);
   const std::filesystem::path& checkpoint = shell.checkpoint_file();
   if (shell.resuming()) {
-    read_checkpoint(checkpoint, c, s, protocol, step.contacts(), liquid);
+    // a checkpoint of another case is an input error of its own; any other
+    // failure to read it means the file is damaged: say what to do with it
+    try {
+      read_checkpoint(checkpoint, c, s, protocol, step.contacts(), liquid);
+    } catch (const input::InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      damaged_checkpoint(checkpoint, e.what());
+    }
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(s.step));
   } else {
     place_spheres(c, modules, box, s.spheres);

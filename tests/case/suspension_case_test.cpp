@@ -695,6 +695,58 @@ TEST(SuspensionCaseCoupling, ControlGainsOutsideTheMeasuredStableRegionAreRefuse
   }
 }
 
+// Issue 41, item 19: gains (1, 1.0000001) were refused as "{integral 1,
+// proportional 1}: outside the region" while (1, 1) is accepted; and sweeps 2
+// with control forcing said "must be >= 1 and <= 1".
+TEST(SuspensionCaseCoupling, RefusedGainsAreShownAsGivenAndSweepsSaysWhy) {
+  json c = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+  c["numerics"] = {
+      {"immersed_boundary",
+       {{"forcing", "control"}, {"gains", {{"integral", 1}, {"proportional", 1.0000001}}}}}};
+  EXPECT_THAT(refusal(c), HasSubstr("gains = {integral 1, proportional 1.0000001}"));
+  c["numerics"]["immersed_boundary"]["gains"]["proportional"] = 1;
+  EXPECT_NO_THROW(parse_suspension_case(c));
+  json sweeps = json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft"})");
+  sweeps["numerics"] = {{"immersed_boundary", {{"forcing", "control"}, {"sweeps", 2}}}};
+  EXPECT_THAT(refusal(sweeps), AllOf(HasSubstr("numerics.immersed_boundary.sweeps = 2"),
+                                     HasSubstr("control forcing makes one correction a step"),
+                                     ::testing::Not(HasSubstr("<= 1"))));
+}
+
+// Issue 41, item 18: a granular scene took immersed_boundary.forcing and
+// coupling "partially-saturated" without a word (and, in a sweep, a new run id).
+TEST(SuspensionCaseCoupling, CouplingOptionsOfAGranularSceneAreNamedAndNotRecorded) {
+  const json plain = json::parse(R"({"scene": "granular", "phi": 0.1, "fidelity": "draft"})");
+  const SuspensionCase base = parse_suspension_case(plain);
+  for (const json& numerics : {json{{"immersed_boundary", {{"forcing", "control"}}}},
+                               json{{"coupling", "partially-saturated"}}}) {
+    json c = plain;
+    c["numerics"] = numerics;
+    const SuspensionCase g = parse_suspension_case(c);
+    const std::string key = numerics.begin().key();
+    bool said = false;
+    for (const auto& w : g.warnings)
+      said = said || (w.find("numerics." + key + ": scene \"granular\" has no liquid") !=
+                      std::string::npos);
+    EXPECT_TRUE(said) << key;
+    EXPECT_EQ(g.to_json(), base.to_json()) << key;
+  }
+}
+
+// Issue 41, item 11: a low Re_inf with the preset's U_inf implied any viscosity
+// (Re_inf 0.01 at draft: nu 56) while the same viscosity given directly is
+// refused above 1; the runs blew up with hints pointing the other way.
+TEST(SuspensionCase, AViscosityImpliedAboveTheCeilingIsRefusedWithTheUInfThatWorks) {
+  json c =
+      json::parse(R"({"scene": "suspension", "phi": 0.2, "fidelity": "draft", "Re_inf": 0.01})");
+  EXPECT_THAT(refusal(c), AllOf(HasSubstr("numerics.viscosity = 2 a U_inf / Re_inf = 56"),
+                                HasSubstr("the draft preset's"), HasSubstr("U_inf <= 0.00125")));
+  c["numerics"] = {{"U_inf", 0.01}};
+  EXPECT_THAT(refusal(c), HasSubstr("numerics.viscosity = 2 a U_inf / Re_inf = 8"));
+  c["numerics"] = {{"U_inf", 0.001}};  // nu 0.8
+  EXPECT_NO_THROW(parse_suspension_case(c));
+}
+
 // Control forcing (markers 1 dx apart) and partially saturated cells take
 // their radius from the shipped table like the other schemes; a hand-given
 // radius must lie where the scheme puts its wall (control forcing: up to

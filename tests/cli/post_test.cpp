@@ -79,5 +79,45 @@ TEST_F(Post, WithoutGnuplotSaysSoAndStillWritesTablesAndAReport) {
   EXPECT_THAT(f.out, AllOf(HasSubstr("no figures can be drawn"), HasSubstr("not on PATH")));
 }
 
+// Issue 41, item 4: post wrote through symbolic links inside --out and
+// overwrote their targets (aggregation.csv, the gnuplot scripts). It now
+// refuses before any work, naming the links, and leaves targets and links be.
+TEST_F(Post, SymbolicLinksWhereOutputGoesAreRefusedAndTheirTargetsKept) {
+  const std::string db = demo_db();
+  const fs::path out = dir_ / "post", target = dir_ / "precious.txt";
+  t::write_text(target, "precious\n");
+  fs::create_directories(out / "figures" / "scripts");
+  fs::create_symlink(target, out / "aggregation.csv");
+  fs::create_symlink(target, out / "figures" / "scripts" / "drag_vs_Re.gp");
+  const t::Output r = t::run(flocsim({"post", "report", "--db", db, "--out", out.string()}));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_THAT(r.out, AllOf(HasSubstr((out / "aggregation.csv").string()),
+                           HasSubstr((out / "figures" / "scripts" / "drag_vs_Re.gp").string()),
+                           HasSubstr("symbolic link")));
+  EXPECT_EQ(t::read_text(target), "precious\n");
+  EXPECT_TRUE(fs::is_symlink(out / "aggregation.csv"));
+  EXPECT_FALSE(fs::exists(out / "figures" / "drag_vs_Re.png")) << "work done before the refusal";
+  // a link of the user's that post does not write is no obstacle
+  fs::remove(out / "aggregation.csv");
+  fs::remove(out / "figures" / "scripts" / "drag_vs_Re.gp");
+  fs::create_symlink(target, out / "notes.txt");
+  const t::Output ok = t::run(flocsim({"post", "tables", "--db", db, "--out", out.string()}));
+  EXPECT_EQ(ok.code, 0) << ok.out;
+  EXPECT_EQ(t::read_text(target), "precious\n");
+}
+
+// Issue 41, item 16: `post report --columns bogus` was refused only after
+// every figure and table was written (and no report.html beside them).
+TEST_F(Post, AnUnknownColumnIsRefusedBeforeAnyWork) {
+  const std::string db = demo_db();
+  const fs::path out = dir_ / "post";
+  const t::Output r = t::run(
+      flocsim({"post", "report", "--db", db, "--out", out.string(), "--columns", "phi,bogus"}));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_THAT(r.out, AllOf(HasSubstr("--columns bogus: no such column"), HasSubstr("F_over_F0")));
+  EXPECT_FALSE(fs::exists(out / "figures")) << r.out;
+  EXPECT_FALSE(fs::exists(out / "aggregation.csv")) << r.out;
+}
+
 }  // namespace
 }  // namespace flocsim

@@ -92,6 +92,45 @@ TEST_F(DbTest, CreatesTheFolderOfANewDatabase) {
   EXPECT_FALSE(fs::exists(dir_ / "absent"));
 }
 
+// Issue 41, item 14: paths SQLite cannot open got "unable to open database
+// file" with no reason; --db "" blamed WAL on a network file system; --db
+// /dev/null said "disk I/O error" and left /dev/null-journal behind.
+TEST_F(DbTest, PathsThatCannotHoldADatabaseAreNamedWithTheReason) {
+  auto error_of = [](const std::string& path, ResultsDb::Mode mode) {
+    try {
+      ResultsDb db(path, mode);
+    } catch (const DbError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(opened)");
+  };
+  EXPECT_NE(error_of("", ResultsDb::Mode::kCreate).find("--db \"\": an empty path"),
+            std::string::npos);
+  std::error_code ec;
+  const bool journal_before = fs::exists("/dev/null-journal", ec);
+  for (auto mode :
+       {ResultsDb::Mode::kCreate, ResultsDb::Mode::kExisting, ResultsDb::Mode::kReadOnly})
+    EXPECT_NE(error_of("/dev/null", mode).find("/dev/null: not a regular file"), std::string::npos)
+        << error_of("/dev/null", mode);
+  if (!journal_before) EXPECT_FALSE(fs::exists("/dev/null-journal", ec));
+  std::ofstream(dir_ / "afile") << "x";
+  const std::string under_file = (dir_ / "afile" / "x.db").string();
+  EXPECT_NE(error_of(under_file, ResultsDb::Mode::kCreate).find("Not a directory"),
+            std::string::npos)
+      << error_of(under_file, ResultsDb::Mode::kCreate);
+  EXPECT_NE(error_of(under_file, ResultsDb::Mode::kExisting).find("Not a directory"),
+            std::string::npos)
+      << error_of(under_file, ResultsDb::Mode::kExisting);
+  EXPECT_NE(error_of(dir_.string(), ResultsDb::Mode::kCreate).find("is a directory"),
+            std::string::npos);
+  // a folder that takes no files though it looks writable: the system's reason
+  const std::string in_proc = error_of("/proc/flocsim_test.sqlite", ResultsDb::Mode::kCreate);
+  EXPECT_EQ(in_proc.find("unable to open database file"), std::string::npos) << in_proc;
+  EXPECT_NE(in_proc.find("cannot create results database /proc/flocsim_test.sqlite: "),
+            std::string::npos)
+      << in_proc;
+}
+
 TEST_F(DbTest, RefusesMissingForeignAndNewerFiles) {
   EXPECT_THROW(ResultsDb(path_, ResultsDb::Mode::kExisting), DbError);
   EXPECT_FALSE(fs::exists(path_));

@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
@@ -155,16 +156,18 @@ TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
 }
 
 TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
-  // The job script and task files of a sweep launched on cuda, against a
-  // stand-in Slurm (squeue answers, sbatch keeps the script and gives a job
-  // id): each array task asks for one GPU unless the sweep names its gres,
-  // and tells its workers --device cuda. Needs a build with the CUDA
-  // back-end (a build without it refuses --device cuda, tested in test_cli).
+  // What a sweep launched on cuda hands sbatch, against a stand-in Slurm
+  // (squeue answers, sbatch writes down its arguments and gives a job id):
+  // each array task asks for one GPU unless the sweep names its gres, and its
+  // task file tells the task's pool --device cuda. Needs a build with the
+  // CUDA back-end (one without refuses --device cuda, tested in test_cli).
   if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
   const fs::path bin = dir_ / "fake-slurm";
   fs::create_directories(bin);
   t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
-  t::write_text(bin / "sbatch", "#!/bin/sh\ncp \"$2\" \"$(dirname \"$0\")/job.sh\"\necho 4242\n");
+  t::write_text(bin / "sbatch",
+                "#!/bin/sh\nfor a in \"$@\"; do echo \"$a\"; done > \"$(dirname \"$0\")/args\"\n"
+                "echo 4242\n");
   fs::permissions(bin / "squeue", fs::perms::owner_all);
   fs::permissions(bin / "sbatch", fs::perms::owner_all);
   const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
@@ -178,16 +181,15 @@ TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
                                         "cuda"}),
                                {path});
     ASSERT_EQ(o.code, 0) << o.out;
-    const std::string script = t::read_text(bin / "job.sh");
-    EXPECT_NE(script.find("#SBATCH --gres=" + (gres.empty() ? "gpu:1" : gres) + "\n"),
-              std::string::npos)
-        << script;
-    // the task files beside the script carry the device to the tasks' pools
-    const std::string at = "#SBATCH --output=";
-    const std::size_t p = script.find(at);
-    ASSERT_NE(p, std::string::npos) << script;
-    const fs::path job_dir =
-        fs::path(script.substr(p + at.size(), script.find('\n', p) - p - at.size())).parent_path();
+    std::vector<std::string> args;
+    std::istringstream lines(t::read_text(bin / "args"));
+    for (std::string line; std::getline(lines, line);) args.push_back(line);
+    ASSERT_FALSE(args.empty());
+    EXPECT_NE(std::find(args.begin(), args.end(), "--gres=" + (gres.empty() ? "gpu:1" : gres)),
+              args.end())
+        << t::read_text(bin / "args");
+    // the task files beside the job script carry the device to the tasks' pools
+    const fs::path job_dir = fs::path(args.back()).parent_path();
     EXPECT_EQ(t::read_json(job_dir / "task_0.json").value("device", ""), "cuda");
   }
 }
@@ -350,6 +352,127 @@ TEST_F(Orchestrator, TruncatedResultIsNeverRecordedAndRetriesStopAtTheLimit) {
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   EXPECT_EQ(db.runs().front().attempts, 2);
   EXPECT_NE(db.runs().front().error.find("not valid JSON"), std::string::npos);
+}
+
+// Issue 41, item 1: a result.json that another run wrote (here: the run of
+// x = 1, copied into the folder of the failed run of x = 2) was recorded by
+// `sweep resume` as "found complete on disk", and x = 2 held x = 1's result.
+TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
+  const std::string sweep = fake_sweep({2}, 2, 10, {{"exit", 1}}, 3);
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);
+  ASSERT_EQ(statuses()[2], "failed");
+  const fs::path other = dir_ / "other";
+  fs::create_directories(other);
+  t::write_text(dir_ / "other.json",
+                json{{"x", 1}, {"fake", {{"steps", 1}, {"step_ms", 1}}}}.dump());
+  ASSERT_EQ(
+      t::run({FAKE_WORKER_EXE, "run", (dir_ / "other.json").string(), "--out", other.string()})
+          .code,
+      0);
+  fs::copy_file(other / "result.json", run_dir(2) / "result.json",
+                fs::copy_options::overwrite_existing);
+  const t::Output r = t::run(resume());
+  EXPECT_EQ(r.out.find("found complete on disk"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("result of another case"), std::string::npos) << r.out;
+  EXPECT_EQ(statuses()[2], "failed");
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.count_results(db.runs().front().id), 0);
+  // the file is not this run's, and not flocsim's to remove
+  EXPECT_TRUE(fs::exists(run_dir(2) / "result.json"));
+}
+
+// Issue 41, item 6: the printed "restart what did not finish with: flocsim
+// sweep resume ... --sweep NAME" left the name unquoted, and a sweep named
+// $(touch${IFS}X) ran touch when the line was pasted into a shell.
+TEST_F(Orchestrator, SuggestedCommandsAreShellQuoted) {
+  const std::string name = "$(touch${IFS}PWNED)";
+  json s{{"name", name},
+         {"base", {{"x", 0}, {"fake", {{"steps", 1}, {"step_ms", 1}, {"exit", 1}}}}},
+         {"axes", {{"x", {1}}}}};
+  t::write_text(dir_ / "evil.json", s.dump());
+  const t::Output o = t::run(launch((dir_ / "evil.json").string()));
+  EXPECT_EQ(o.code, 1) << o.out;
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  for (const std::string& text : {o.out, st.out}) {
+    const auto at = text.find("flocsim sweep resume ");
+    ASSERT_NE(at, std::string::npos) << text;
+    const std::string line = text.substr(at, text.find('\n', at) - at);
+    // the line as a shell reads it, with echo in the place of flocsim
+    const t::Output echoed =
+        t::run({"/bin/sh", "-c", "cd " + dir_.string() + " && echo " + line.substr(8)});
+    EXPECT_EQ(echoed.out, "sweep resume --db " + db_ + " --sweep " + name + "\n") << line;
+    EXPECT_FALSE(fs::exists(dir_ / "PWNED")) << line;
+  }
+}
+
+// Issue 41, item 13: a missing --worker failed every run with exit 127,
+// naming no path, and each failure used up an attempt.
+TEST_F(Orchestrator, AWorkerThatCannotStartIsRefusedBeforeAnyAttempt) {
+  const std::string sweep = fake_sweep({1}, 1, 1, {{"exit", 1}}, 3);
+  const std::string missing = (dir_ / "no-such-worker").string();
+  const t::Output l = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--worker", missing}));
+  EXPECT_EQ(l.code, 2) << l.out;
+  EXPECT_NE(l.out.find("--worker " + missing + ": no such file"), std::string::npos) << l.out;
+  EXPECT_FALSE(fs::exists(db_)) << "registered before the refusal";
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);  // one real, failed attempt
+  t::write_text(dir_ / "not-executable", "#!/bin/sh\n");
+  for (const std::string& worker :
+       {missing, (dir_ / "not-executable").string(), std::string("no-such-program-on-path")}) {
+    const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_, "--worker", worker}));
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("--worker " + worker + ": "), std::string::npos) << r.out;
+  }
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 1);
+}
+
+// Issue 41, item 8: `sweep resume --backend slurm` trusted the Slurm settings
+// stored in the database: runs_per_task 0 wrote empty task files without end
+// (and ignored SIGTERM), a string for cpus_per_task gave a raw type_error.
+// They are checked as `sweep launch` checks them, before Slurm is asked.
+TEST_F(Orchestrator, StoredSlurmSettingsAreCheckedAsLaunchChecksThem) {
+  const std::string sweep = fake_sweep({1}, 1, 1, {{"exit", 1}}, 3);
+  EXPECT_EQ(t::run(launch(sweep)).code, 1);
+  const json file = t::read_json(sweep);
+  for (const auto& [field, value, expect] :
+       {std::tuple<std::string, json, std::string>{"runs_per_task", 0, "slurm.runs_per_task = 0"},
+        {"cpus_per_task", "eight", "slurm.cpus_per_task"},
+        {"time_limit", "abc", "slurm.time_limit = \"abc\""}}) {
+    json stored = file;
+    stored["slurm"] = {{field, value}};
+    {
+      ResultsDb db(db_, ResultsDb::Mode::kExisting);
+      db.upsert_sweep("fake", stored.dump(), "[\"x\"]", 3);
+    }
+    const t::Output r = t::run({"/usr/bin/timeout", "20", FLOCSIM_EXE, "sweep", "resume", "--db",
+                                db_, "--backend", "slurm", "--worker", FAKE_WORKER_EXE});
+    EXPECT_EQ(r.code, 2) << field << ": " << r.out;
+    EXPECT_NE(r.out.find(expect), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("as stored"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "results.runs" / "slurm")) << "task files written";
+}
+
+// Issue 41, item 7: ESC sequences and U+202E in names and axis values reached
+// the terminal raw through launch, status and query.
+TEST_F(Orchestrator, ControlAndBidiCharactersAreShownEscaped) {
+  const std::string esc = "\x1b[2J", rlo = "\xe2\x80\xae";
+  json s{{"name", "n" + esc + "a" + rlo + "me"},
+         {"base", {{"x", 0}, {"fake", {{"steps", 1}, {"step_ms", 1}}}}},
+         {"axes", {{"label", {"red" + esc, "evil" + rlo + "gpj.exe"}}}}};
+  t::write_text(dir_ / "odd.json", s.dump());
+  const t::Output l = t::run(launch((dir_ / "odd.json").string()));
+  EXPECT_EQ(l.code, 0) << l.out;
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  const t::Output q = t::run(flocsim({"query", "--db", db_}));
+  for (const t::Output* o : {&l, &st, &q}) {
+    EXPECT_EQ(o->out.find('\x1b'), std::string::npos) << o->out;
+    EXPECT_EQ(o->out.find(rlo), std::string::npos) << o->out;
+  }
+  EXPECT_NE(l.out.find("label=red\\x1b[2J"), std::string::npos) << l.out;
+  EXPECT_NE(l.out.find("evil\\u202egpj.exe"), std::string::npos) << l.out;
+  EXPECT_NE(st.out.find("sweep n\\x1b[2Ja\\u202eme"), std::string::npos) << st.out;
+  EXPECT_NE(q.out.find("\\u202e"), std::string::npos) << q.out;
 }
 
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
@@ -666,6 +789,74 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
   EXPECT_NE(st.out.find("is read-only"), std::string::npos) << st.out;
   EXPECT_EQ(w.code, 1) << w.out;
   EXPECT_NE(w.out.find(ro_db + " is read-only"), std::string::npos) << w.out;
+}
+
+// Issue 41, item 20: `sweep cancel` refused a read-only database, though it
+// only reads the live attempts and signals their owners.
+TEST_F(Orchestrator, CancelReadsAReadOnlyDatabase) {
+  const fs::path rw = dir_ / "rw", ro = dir_ / "ro";
+  fs::create_directories(rw);
+  fs::create_directories(ro);
+  const std::string db = (rw / "results.db").string();
+  ASSERT_EQ(t::run(flocsim({"sweep", "launch", fake_sweep({1}, 1, 1), "--db", db, "--worker",
+                            FAKE_WORKER_EXE}))
+                .code,
+            0);
+  if (::geteuid() != 0 ||
+      std::system(("mount --bind " + rw.string() + " " + ro.string() +
+                   " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
+                      .c_str()) != 0) {
+    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+    GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
+  }
+  const t::Output c = t::run(flocsim({"sweep", "cancel", "--db", (ro / "results.db").string()}));
+  std::system(("umount " + ro.string()).c_str());
+  EXPECT_EQ(c.code, 0) << c.out;
+  EXPECT_NE(c.out.find("nothing is running"), std::string::npos) << c.out;
+}
+
+// Issue 41, item 12: `sweep plan --jobs 4096` built 4096 copies of the demo's
+// case to time them together (29 GB) before any memory check, and died of
+// std::bad_alloc under a memory limit. It now times as many as fit.
+TEST_F(Orchestrator, PlanWithMoreJobsThanMemoryHoldsTimesOneCopy) {
+  // the demo's case (about 7 MB) over 600 seeds, under a 2 GB address-space
+  // limit: 600 copies timed together would need about 4 GB
+  json s = t::read_json(FLOCSIM_SOURCE_DIR "/sweeps/demo.json");
+  json seeds = json::array();
+  for (int k = 1; k <= 600; ++k) seeds.push_back(k);
+  s["axes"] = {{"seed", seeds}};
+  t::write_text(dir_ / "many.json", s.dump());
+  const t::Output o =
+      t::run({"/usr/bin/prlimit", "--as=2000000000", FLOCSIM_EXE, "sweep", "plan",
+              (dir_ / "many.json").string(), "--jobs", "4096", "--measure-steps", "1"});
+  EXPECT_EQ(o.code, 0) << o.out.substr(0, 3000);
+  EXPECT_NE(o.out.find("600 runs"), std::string::npos) << o.out.substr(0, 3000);
+}
+
+// Issue 41, item 15: on a full file system `sweep status` and `resume` failed
+// with SQLite's "disk I/O error" and never mentioned space. Status reads the
+// database as it does a read-only one and says the disk is full.
+TEST_F(Orchestrator, AFullDiskIsNamedAndStatusStillReads) {
+  const fs::path full = dir_ / "full";
+  fs::create_directories(full);
+  if (::geteuid() != 0 ||
+      std::system(("mount -t tmpfs -o size=2m tmpfs " + full.string() + " 2>/dev/null").c_str()) !=
+          0)
+    GTEST_SKIP() << "cannot mount a small file system here (needs root)";
+  const std::string db = (full / "results.db").string();
+  const t::Output l = t::run(flocsim({"sweep", "launch", fake_sweep({1}, 1, 1, {{"exit", 1}}, 3),
+                                      "--db", db, "--worker", FAKE_WORKER_EXE}));
+  std::system(("dd if=/dev/zero of=" + (full / "fill").string() + " bs=4k 2>/dev/null").c_str());
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db}));
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db, "--worker", FAKE_WORKER_EXE}));
+  std::system(("umount " + full.string()).c_str());
+  EXPECT_EQ(l.code, 1) << l.out;
+  EXPECT_EQ(st.code, 0) << st.out;
+  EXPECT_NE(st.out.find("the file system under it is full"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("sweep fake"), std::string::npos) << st.out;
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("is full"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("disk I/O error"), std::string::npos) << r.out;
 }
 
 // The real worker: the CI sweep with `flocsim run`, then a real run killed with

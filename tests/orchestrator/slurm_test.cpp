@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 #include "db/results_db.hpp"
 #include "harness.hpp"
@@ -133,6 +134,76 @@ TEST_F(Slurm, CancelledJobIsResumedFromCheckpointsByANewArray) {
               attempts[1].job_id.substr(0, attempts[1].job_id.find('_')));
   }
   EXPECT_EQ(db.integrity_check(), "ok");
+}
+
+// Issue 41, item 5: the #SBATCH lines were written unquoted: a space in the
+// runs folder ("Invalid directive"), a % in the sweep name (the task's output
+// file could not be opened; the job failed before it ran, yet flocsim said
+// "finished"), a " ("Unmatched quote"), a 300-character name ("File name too
+// long"). The real sbatch must take them all and the runs complete.
+TEST_F(Slurm, OddNamesAndFoldersReachSlurmIntact) {
+  const fs::path folder = dir_ / "my runs %j \"q\"";
+  fs::create_directories(folder);
+  fs::permissions(folder, fs::perms::all);
+  int k = 0;
+  for (const std::string& name : {std::string("50%x\"done#1"), std::string(300, 'n')}) {
+    SCOPED_TRACE(name.substr(0, 20));
+    json s{{"name", name},
+           {"base", {{"x", 0}, {"fake", {{"steps", 2}, {"step_ms", 10}}}}},
+           {"axes", {{"x", {1, 2}}}}};
+    const fs::path file = dir_ / ("odd" + std::to_string(k) + ".json");
+    t::write_text(file, s.dump());
+    const std::string db = (folder / ("results" + std::to_string(k++) + ".db")).string();
+    const t::Output o = t::run(flocsim({"sweep", "launch", file.string(), "--db", db, "--backend",
+                                        "slurm", "--worker", FAKE_WORKER_EXE}));
+    EXPECT_EQ(o.code, 0) << o.out;
+    EXPECT_NE(o.out.find(" finished"), std::string::npos) << o.out;
+    ResultsDb rdb(db, ResultsDb::Mode::kExisting);
+    for (const auto& r : rdb.runs()) EXPECT_EQ(r.status, RunState::kCompleted) << r.error;
+  }
+}
+
+// Issue 41, item 5: a job whose tasks fail before they run recorded nothing,
+// and flocsim said "job N finished", leaving the runs pending with no reason.
+// Slurm's own state of each task is reported.
+TEST_F(Slurm, ATaskThatFailsBeforeItRunsIsReportedWithSlurmsState) {
+  json s{{"name", "broken"},
+         {"base", {{"x", 0}, {"fake", {{"steps", 2}, {"step_ms", 10}}}}},
+         {"axes", {{"x", {1}}}}};
+  t::write_text(dir_ / "broken.json", s.dump());
+  const t::Output o = t::run(flocsim({"sweep", "launch", (dir_ / "broken.json").string(), "--db",
+                                      db_, "--backend", "slurm", "--worker", FAKE_WORKER_EXE}),
+                             {"FLOCSIM_SWEEP_EXE=" + (dir_ / "no-such-flocsim").string()});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("ended with Slurm's failure: task 0 FAILED"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("task_0.out"), std::string::npos) << o.out;
+  std::istringstream lines(o.out);
+  for (std::string line; std::getline(lines, line);)
+    EXPECT_FALSE(line.rfind("slurm: job ", 0) == 0 && line.size() > 9 &&
+                 line.compare(line.size() - 9, 9, " finished") == 0)
+        << line;
+}
+
+// Issue 41, item 10: with squeue on PATH but no sbatch, launch said
+// "sbatch failed (exit -1):" and no reason.
+TEST_F(Slurm, AMissingSbatchIsNamed) {
+  const fs::path bin = dir_ / "bin";
+  fs::create_directories(bin);
+  for (const char* program : {"squeue", "scontrol"}) {
+    const fs::path real = fs::exists("/usr/bin/" + std::string(program))
+                              ? fs::path("/usr/bin/" + std::string(program))
+                              : fs::path("/usr/sbin/" + std::string(program));
+    fs::create_symlink(real, bin / program);
+  }
+  json s{{"name", "nosbatch"},
+         {"base", {{"x", 0}, {"fake", {{"steps", 2}, {"step_ms", 10}}}}},
+         {"axes", {{"x", {1}}}}};
+  t::write_text(dir_ / "nosbatch.json", s.dump());
+  const t::Output o = t::run(flocsim({"sweep", "launch", (dir_ / "nosbatch.json").string(), "--db",
+                                      db_, "--backend", "slurm", "--worker", FAKE_WORKER_EXE}),
+                             {"PATH=" + bin.string()});
+  EXPECT_NE(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("sbatch is not on PATH (" + bin.string() + ")"), std::string::npos) << o.out;
 }
 
 }  // namespace

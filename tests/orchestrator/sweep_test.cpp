@@ -3,7 +3,10 @@
 #include "orchestrator/sweep.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "engine/input/input_reader.hpp"
@@ -36,6 +39,16 @@ TEST(Sha256, MatchesFipsTestVectors) {
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   EXPECT_EQ(orc::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+}
+
+// Issue 41, item 6: the words of the commands flocsim suggests.
+TEST(ShellWord, PlainWordsStayAndEverythingElseIsSingleQuoted) {
+  EXPECT_EQ(orc::shell_word("demo-1.sqlite"), "demo-1.sqlite");
+  EXPECT_EQ(orc::shell_word("/runs/a_b/c:d"), "/runs/a_b/c:d");
+  EXPECT_EQ(orc::shell_word("$(touch${IFS}X)"), "'$(touch${IFS}X)'");
+  EXPECT_EQ(orc::shell_word("my runs/d.sqlite"), "'my runs/d.sqlite'");
+  EXPECT_EQ(orc::shell_word("bob's"), "'bob'\\''s'");
+  EXPECT_EQ(orc::shell_word(""), "''");
 }
 
 TEST(Canonical, SortsKeysAndNormalisesNumbers) {
@@ -149,6 +162,26 @@ TEST(SweepErrors, SlurmValuesCannotEndAJobScriptLine) {
             std::string::npos);
 }
 
+// Issue 41, item 9: slurm.time_limit "abc" was accepted until sbatch refused
+// it after the sweep was registered; twenty digits gave "error: stol".
+TEST(SweepErrors, SlurmTimeLimitIsParsedWhenTheSweepIsRead) {
+  for (const char* limit : {"abc", "99999999999999999999", "1:2:3:4", "1-"}) {
+    const std::string file =
+        std::string(R"({"name": "a", "base": {}, "axes": {}, "slurm": {"time_limit": ")") + limit +
+        R"("}})";
+    EXPECT_NE(error_of(file).find(std::string("slurm.time_limit = \"") + limit + "\""),
+              std::string::npos)
+        << error_of(file);
+    EXPECT_NE(error_of(file).find("HOURS:MINUTES:SECONDS"), std::string::npos) << error_of(file);
+  }
+  for (const char* limit : {"90", "10:30", "01:00:00", "2-00:00:00", "1-12", "UNLIMITED"})
+    EXPECT_EQ(
+        error_of(std::string(R"({"name": "a", "base": {}, "axes": {}, "slurm": {"time_limit": ")") +
+                 limit + R"("}})"),
+        "(no error)")
+        << limit;
+}
+
 TEST(SweepErrors, UnreadableOrInvalidFilesNameTheFile) {
   try {
     orc::read_sweep_file("/nonexistent/sweep.json");
@@ -157,6 +190,28 @@ TEST(SweepErrors, UnreadableOrInvalidFilesNameTheFile) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/sweep.json: cannot be opened"),
               std::string::npos);
   }
+}
+
+// Issue 41, item 17: a relative positions_from resolved against the folder the
+// sweep was launched from. It names a file beside the sweep file, stored absolute.
+TEST(SweepFiles, ARelativePositionsFromIsBesideTheSweepFile) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("flocsim_sweep_pf_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir / "sub");
+  {
+    std::ofstream(dir / "sub" / "s.json") << R"({"name": "pf", "axes": {},
+      "base": {"scene": "fixed-array", "positions_from": "snaps/step_0000000010.h5"}})";
+    std::ofstream(dir / "sub" / "t.json") << R"({"name": "pf2", "base": {"scene": "fixed-array"},
+      "axes": {"positions_from": ["../a.h5", "/abs/b.h5"]}})";
+  }
+  const auto s = orc::read_sweep_file((dir / "sub" / "s.json").string());
+  EXPECT_EQ(s.base["positions_from"], (dir / "sub" / "snaps" / "step_0000000010.h5").string());
+  EXPECT_EQ(s.source["base"]["positions_from"], s.base["positions_from"]);  // as stored
+  const auto runs = orc::expand(orc::read_sweep_file((dir / "sub" / "t.json").string()));
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0].case_json["positions_from"], (dir / "a.h5").string());
+  EXPECT_EQ(runs[1].case_json["positions_from"], "/abs/b.h5");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ShippedSweeps, ParseAndExpandToTheirGrids) {

@@ -467,6 +467,36 @@ TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
   EXPECT_THAT(html.str(), HasSubstr(">completed</td>"));  // the provenance table's state
 }
 
+// Issue 41, item 2: a completed run whose series.h5 was missing or damaged
+// was left out of the time-series figures without a word (exit 0, the tables
+// still listing it). Each is named with its file, the reason and the figures.
+TEST_F(Post, ACompletedRunWithoutItsSeriesIsNamedWithTheFiguresItIsMissingFrom) {
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"agg", suspension(0.02), "completed", 3.0, 0.09, 8.0, 0.4},
+                {"agg3", suspension(0.03), "completed", 2.8, 0.09, 12.0, 0.6},
+                {"later", suspension(0.04), "pending"}},
+               /*with_series=*/true);
+  fs::remove(dir_ / "agg" / "series.h5");
+  fs::resize_file(dir_ / "agg3" / "series.h5", 100);  // cut short
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const auto runs = load_runs(db, std::nullopt, {});
+  const FigureSet set = write_figures(runs, dir_ / "figures");
+  ASSERT_EQ(set.runs_left_out.size(), 2u);  // not the pending run: it has no series yet
+  EXPECT_THAT(set.runs_left_out[0],
+              AllOf(HasSubstr("run agg "), HasSubstr((dir_ / "agg" / "series.h5").string()),
+                    HasSubstr("is missing"), HasSubstr("timeseries_phi0.2_Re12"),
+                    HasSubstr("spacetime_phi0.2_Re12_du0.02")));
+  EXPECT_THAT(set.runs_left_out[1], AllOf(HasSubstr("run agg3 "), HasSubstr("cannot be read"),
+                                          HasSubstr("size_distribution_phi0.2_Re12")));
+  write_report(runs, set, db_path, dir_ / "report.html");
+  std::ifstream in(dir_ / "report.html");
+  std::stringstream html;
+  html << in.rdbuf();
+  EXPECT_THAT(html.str(), AllOf(HasSubstr("Left out of figures: run agg "),
+                                HasSubstr("Left out of figures: run agg3 ")));
+}
+
 TEST_F(Post, NoSingleValueWidensTheReportsTablesBeyondThePage) {
   // A sweep name a script made from every parameter: before, it stretched the
   // provenance table to ten page widths, and the tables ran off a 1400-pixel page.

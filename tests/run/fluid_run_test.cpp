@@ -292,6 +292,63 @@ TEST(OutputDirectory, ResumingACompletedRunOfAnotherCaseIsRefusedNamingTheField)
   fs::remove_all(o);
 }
 
+// Issue 41, item 3: a result.json cut short made a run unresumable: --resume
+// said "already completed", then failed on a raw JSON parse error naming no
+// file, at every resume until the file was removed by hand.
+TEST(OutputDirectory, AnUnreadableResultIsSetAsideAndTheRunGoesOn) {
+  const fs::path o = fresh_dir("unreadable_result");
+  // with a checkpoint: the run continues from it
+  ASSERT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 12}).outcome,
+            RunOutcome::interrupted);
+  std::ofstream(o / "result.json") << "{\"status\": \"comp";
+  // without --resume: refused, naming the file and the way out
+  try {
+    run_fluid_case(small_case(0.05), {o, false, true, 0});
+    ADD_FAILURE() << "a fresh start went ahead over an unreadable result.json";
+  } catch (const input::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("result.json: cannot be read"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("--resume"), std::string::npos) << e.what();
+  }
+  const RunReport r = run_fluid_case(small_case(0.05), {o, true, true, 0});
+  ASSERT_EQ(r.outcome, RunOutcome::completed) << r.message;
+  EXPECT_EQ(text_of(o / "result.json.unreadable"), "{\"status\": \"comp");  // kept, not removed
+  EXPECT_EQ(json::parse(text_of(o / "result.json")).value("status", ""), "completed");
+  EXPECT_NE(text_of(o / "run.log").find("continues from its checkpoint"), std::string::npos);
+  // completed, no checkpoint left: the run record says it is this case, so it starts again
+  std::ofstream(o / "result.json") << "[1, 2";
+  const RunReport again = run_fluid_case(small_case(0.05), {o, true, true, 0});
+  ASSERT_EQ(again.outcome, RunOutcome::completed) << again.message;
+  EXPECT_EQ(text_of(o / "result.json.unreadable.1"), "[1, 2");
+  // a damaged result.json that nothing says this case wrote is the user's: refused
+  const fs::path foreign = fresh_dir("unreadable_foreign_result");
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "result.json") << "{";
+  EXPECT_THROW(run_fluid_case(small_case(0.05), {foreign, true, true, 0}), input::InputError);
+  EXPECT_EQ(text_of(foreign / "result.json"), "{");
+  fs::remove_all(o);
+  fs::remove_all(foreign);
+}
+
+// Issue 41, item 3: a damaged checkpoint.h5 failed with HDF5's words only;
+// the failure now names the file and what to do with it.
+TEST(OutputDirectory, ADamagedCheckpointSaysWhatToDoWithIt) {
+  const fs::path o = fresh_dir("damaged_checkpoint");
+  ASSERT_EQ(run_fluid_case(small_case(0.05), {o, false, true, 12}).outcome,
+            RunOutcome::interrupted);
+  std::ofstream(o / "checkpoint.h5", std::ios::trunc) << "not hdf5";
+  const RunReport r = run_fluid_case(small_case(0.05), {o, true, true, 0});
+  EXPECT_EQ(r.outcome, RunOutcome::failed);
+  EXPECT_NE(r.message.find((o / "checkpoint.h5").string() + " cannot be read"), std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("Move it away"), std::string::npos) << r.message;
+  EXPECT_EQ(text_of(o / "checkpoint.h5"), "not hdf5");
+  // moved away, --resume starts the case over
+  fs::rename(o / "checkpoint.h5", o / "checkpoint.h5.bad");
+  EXPECT_EQ(run_fluid_case(small_case(0.05), {o, true, true, 0}).outcome, RunOutcome::completed);
+  fs::remove_all(o);
+}
+
 TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
   // The reproducer of the report: a folder holding the user's spheres/mine.txt
   // and a file called `fields`; the fresh run removed both and exited 0.
