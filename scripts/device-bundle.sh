@@ -43,7 +43,8 @@ done
 # A native build (FLOCSIM_NATIVE, the default) runs only on processors with
 # this one's vector instructions: the device check compares before it starts.
 if grep -q "FLOCSIM_NATIVE:BOOL=ON" "$build/CMakeCache.txt"; then
-  grep -o -w "avx512f\|avx2\|fma" /proc/cpuinfo | sort -u > "$bundle.tmp/cpu-flags.txt"
+  grep -o -w "avx[0-9a-z_]*\|fma\|f16c\|bmi[12]\|vpclmulqdq\|gfni\|vaes" /proc/cpuinfo |
+    sort -u > "$bundle.tmp/cpu-flags.txt"
 fi
 strip --strip-unneeded "$bundle.tmp"/bin/* 2>/dev/null || true
 rm -rf "$bundle"

@@ -6,6 +6,7 @@
 # figure into one folder. Sized to finish in under 8 minutes, so a 15-minute
 # device session holds it and a rerun.
 #
+# Time limits per step: 90 + 150 + 60 + 4 x 45 = 480 s at most.
 # Usage (from the repository root, on the GPU machine):
 #   scripts/device-check.sh [BUNDLE] [OUT]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
@@ -58,16 +59,17 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
 cat "$out/machine.txt"
 
 # 1. the GPU against the CPU reference (tests/lattice_gpu)
-step gpu-tests 180 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
+step gpu-tests 90 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
 
 # 2. the fluid kernel: paper's box and 256^3, float and double, against the
 #    device's copy bandwidth
-step bench-fluid-gpu 240 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
+step bench-fluid-gpu 150 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
   --json "$out/bench-fluid-gpu.json"
 
-# 3. the CPU kernel on this machine's cores, for the speed-up
-step bench-fluid-cpu 120 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
-  --size 144 --precision all --forcing uniform --json "$out/bench-fluid-cpu.json"
+# 3. the CPU kernel on this machine's cores at 256^3, the GPU's second box,
+#    for the speed-up
+step bench-fluid-cpu 60 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
+  --size 256 --precision all --forcing uniform --json "$out/bench-fluid-cpu.json"
 
 # 4. the fluid scene at the paper's box (288 x 144 x 144): a shear wave with
 #    a body force, float and double, on the GPU; and on the CPU for the ratio
@@ -81,7 +83,7 @@ for precision in float double; do
            "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
  "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
 CASE
-    step "run-paper-box-$precision-$device" 120 "$bundle/bin/flocsim" run \
+    step "run-paper-box-$precision-$device" 45 "$bundle/bin/flocsim" run \
       "$out/paper-box-$precision-$device.json" --out "$out/run-paper-box-$precision-$device" --quiet
   done
 done

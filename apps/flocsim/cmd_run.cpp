@@ -47,17 +47,18 @@ int run_command(const RunArguments& a) {
                    "with --device cpu\n", a.case_file.c_str(), q.why_none.c_str());
       return kExitBadInput;
     }
-    // the populations must fit the GPU's memory (the host mirror is checked
-    // with the case, against this machine's)
+    // the populations must fit the GPU's free memory (the host mirror is
+    // checked with the case, against this machine's); the lattice takes its
+    // memory before any output too, should another process take it meanwhile
     const double bytes = 19.0 * static_cast<double>(parsed.fluid.size.cells()) *
                          (parsed.fluid.precision == cases::Precision::single_precision ? 4 : 8);
-    const double available = 0.9 * q.devices.front().memory_gib * (1u << 30);
+    const double available = 0.9 * q.devices.front().free_gib * (1u << 30);
     if (bytes > available) {
       std::fprintf(stderr,
                    "flocsim run: input error in %s: fluid.size: the populations take %.1f GiB, "
-                   "more than 90 %% of the GPU's %.1f GiB (%s); use a smaller box, float "
+                   "more than 90 %% of the %.1f GiB free on the GPU (%s); use a smaller box, float "
                    "precision, or --device cpu\n",
-                   a.case_file.c_str(), bytes / (1u << 30), q.devices.front().memory_gib,
+                   a.case_file.c_str(), bytes / (1u << 30), q.devices.front().free_gib,
                    q.devices.front().name.c_str());
       return kExitBadInput;
     }

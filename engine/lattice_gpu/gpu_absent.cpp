@@ -20,6 +20,8 @@ bool built_with_cuda() { return false; }
 
 GpuQuery query_gpus() { return {{}, kNoCuda}; }
 
+GpuDevice use_first_gpu() { throw std::runtime_error(kNoCuda); }
+
 double measure_copy_bandwidth_gbs(std::size_t, int) { throw std::runtime_error(kNoCuda); }
 
 template <class Real>
@@ -48,6 +50,12 @@ template <class Real>
 lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const { return {}; }
 template <class Real>
 std::size_t GpuFluidLattice<Real>::bytes_per_cell_update() const { return 0; }
+
+template <class Real>
+const GpuDevice& GpuFluidLattice<Real>::gpu() const {
+  static const GpuDevice none;
+  return none;
+}
 
 template class GpuFluidLattice<float>;
 template class GpuFluidLattice<double>;

@@ -92,6 +92,7 @@ struct GpuFluidLattice<Real>::Device {
   Real* force[3] = {nullptr, nullptr, nullptr};
   double* partial = nullptr;  // reduction blocks x 4
   int reduction_blocks = 0;
+  GpuDevice gpu;  // where all of it lives
 
   ~Device() {
     cudaFree(populations);
@@ -104,8 +105,12 @@ template <class Real>
 GpuFluidLattice<Real>::GpuFluidLattice(lattice::Extent extent, lattice::Relaxation relaxation)
     : extent_(extent), relaxation_(relaxation), device_(std::make_unique<Device>()) {
   relaxation_.check();
-  const GpuQuery q = query_gpus();
-  if (q.devices.empty()) throw std::runtime_error(q.why_none);
+  // one row of cells per block along x: the grid's y and z are the rows
+  if (extent.nx < 1 || extent.ny < 1 || extent.nz < 1 || extent.ny > 65535 || extent.nz > 65535)
+    throw std::invalid_argument("GPU lattice: extent " + std::to_string(extent.nx) + " x " +
+                                std::to_string(extent.ny) + " x " + std::to_string(extent.nz) +
+                                ": each side must be at least 1, y and z at most 65535");
+  device_->gpu = use_first_gpu();
   // Direction arrays start on 512-byte boundaries: every warp's loads of a
   // row segment fall in as few memory transactions as the shift allows.
   const long align = 512 / static_cast<long>(sizeof(Real));
@@ -115,7 +120,8 @@ GpuFluidLattice<Real>::GpuFluidLattice(lattice::Extent extent, lattice::Relaxati
              ("cudaMalloc of the populations (" + std::to_string(bytes >> 20) + " MiB)").c_str());
   cuda_check(cudaMemset(device_->populations, 0, bytes), "cudaMemset of the populations");
   int sms = 0;
-  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0), "device attribute");
+  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device_->gpu.index),
+             "device attribute");
   device_->reduction_blocks = 4 * sms;
   cuda_check(cudaMalloc(&device_->partial, sizeof(double) * 4 * device_->reduction_blocks),
              "cudaMalloc of the reduction buffer");
@@ -139,7 +145,16 @@ void GpuFluidLattice<Real>::upload(const lattice::FluidLattice<Real>& host) {
   time_step_ = host.time_step();
   body_force_ = host.body_force();
   const auto field = host.force_field_if_set();
-  if (!field.empty()) upload_force_field(field);
+  if (!field.empty()) {
+    upload_force_field(field);
+  } else {
+    // the host has none: neither has the device (a field left from before
+    // would go on acting)
+    for (Real*& f : device_->force) {
+      cudaFree(f);
+      f = nullptr;
+    }
+  }
 }
 
 template <class Real>
@@ -159,6 +174,9 @@ void GpuFluidLattice<Real>::download(lattice::FluidLattice<Real>& host) const {
 
 template <class Real>
 void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<const Real>& field) {
+  if (field.extent.nx != extent_.nx || field.extent.ny != extent_.ny ||
+      field.extent.nz != extent_.nz || field.empty())
+    throw std::invalid_argument("GPU lattice: a force field of another extent, or none");
   const std::size_t bytes = sizeof(Real) * static_cast<std::size_t>(extent_.cells());
   for (int d = 0; d < 3; ++d) {
     if (!device_->force[d])
@@ -237,6 +255,11 @@ lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const {
 template <class Real>
 std::size_t GpuFluidLattice<Real>::bytes_per_cell_update() const {
   return (2 * d3q19::kQ + (device_->force[0] ? 3 : 0)) * sizeof(Real);
+}
+
+template <class Real>
+const GpuDevice& GpuFluidLattice<Real>::gpu() const {
+  return device_->gpu;
 }
 
 template class GpuFluidLattice<float>;

@@ -18,14 +18,16 @@
 #include <memory>
 
 #include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 
 namespace flocsim::gpu {
 
 template <class Real>
 class GpuFluidLattice {
  public:
-  // On the current CUDA device (0 unless CUDA_VISIBLE_DEVICES says otherwise);
-  // throws std::runtime_error when no GPU can be used, with the reason.
+  // On the first usable GPU (use_first_gpu; CUDA_VISIBLE_DEVICES chooses which
+  // are seen), made current for this thread; throws std::runtime_error when
+  // no GPU can be used, with the reason.
   GpuFluidLattice(lattice::Extent extent, lattice::Relaxation relaxation);
   ~GpuFluidLattice();
   GpuFluidLattice(const GpuFluidLattice&) = delete;
@@ -39,7 +41,8 @@ class GpuFluidLattice {
   // The whole state of `host` (populations, time step, body force and, when
   // it has one, its per-cell force field) onto the device; same extent.
   void upload(const lattice::FluidLattice<Real>& host);
-  // The populations and the time step back into `host` (same extent).
+  // The populations and the time step back into `host` (same extent); not the
+  // body force or the force field, which the host keeps as it set them.
   void download(lattice::FluidLattice<Real>& host) const;
   // The per-cell force field of the next steps, from the host (x fastest).
   void upload_force_field(const lattice::ForceFieldView<const Real>& field);
@@ -52,6 +55,8 @@ class GpuFluidLattice {
   double total_mass() const;
   lattice::Vector3 total_momentum() const;
   std::size_t bytes_per_cell_update() const;
+  // The GPU it runs on.
+  const GpuDevice& gpu() const;
 
  private:
   struct Device;  // device memory, defined in the .cu

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,13 +33,15 @@ GpuQuery query_gpus() {
     if (cudaGetDeviceProperties(&p, d) != cudaSuccess) continue;
     // The build carries machine code for FLOCSIM_CUDA_MIN_ARCH (Hopper, 90)
     // and PTX that newer GPUs compile; older ones cannot run it.
-    if (p.major * 10 + p.minor < FLOCSIM_CUDA_MIN_ARCH) {
+    if (FLOCSIM_CUDA_MIN_ARCH > 0 && p.major * 10 + p.minor < FLOCSIM_CUDA_MIN_ARCH) {
       too_old += std::string(too_old.empty() ? "" : "; ") + p.name + " (compute capability " +
                  std::to_string(p.major) + "." + std::to_string(p.minor) + ")";
       continue;
     }
-    q.devices.push_back({d, p.name, static_cast<double>(p.totalGlobalMem) / (1u << 30), p.major,
-                         p.minor});
+    std::size_t free = 0, total = 0;
+    if (cudaSetDevice(d) == cudaSuccess) cudaMemGetInfo(&free, &total);
+    q.devices.push_back({d, p.name, static_cast<double>(p.totalGlobalMem) / (1u << 30),
+                         static_cast<double>(free) / (1u << 30), p.major, p.minor});
   }
   if (q.devices.empty())
     q.why_none = "the visible GPUs are older than this build's code (compute capability " +
@@ -46,6 +49,13 @@ GpuQuery query_gpus() {
                  std::to_string(FLOCSIM_CUDA_MIN_ARCH % 10) + " and newer): " + too_old +
                  "; configure with -DCMAKE_CUDA_ARCHITECTURES=<theirs> to build for them";
   return q;
+}
+
+GpuDevice use_first_gpu() {
+  const GpuQuery q = query_gpus();
+  if (q.devices.empty()) throw std::runtime_error(q.why_none);
+  cuda_check(cudaSetDevice(q.devices.front().index), "cudaSetDevice");
+  return q.devices.front();
 }
 
 namespace {
@@ -60,18 +70,23 @@ __global__ void copy_kernel(const double2* __restrict__ in, double2* __restrict_
 }  // namespace
 
 double measure_copy_bandwidth_gbs(std::size_t bytes, int reps) {
+  if (reps < 1) throw std::invalid_argument("copy bandwidth: reps must be >= 1");
   const std::size_t n = bytes / sizeof(double2);
   double2 *in = nullptr, *out = nullptr;
   cuda_check(cudaMalloc(&in, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
   cuda_check(cudaMalloc(&out, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
   cuda_check(cudaMemset(in, 0, n * sizeof(double2)), "cudaMemset");
   int sms = 0;
-  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0), "device attribute");
+  int device = 0;
+  cuda_check(cudaGetDevice(&device), "cudaGetDevice");
+  cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
+             "device attribute");
   const int blocks = sms * 8, threads = 256;
   cudaEvent_t start, stop;
   cudaEventCreate(&start);
   cudaEventCreate(&stop);
   copy_kernel<<<blocks, threads>>>(in, out, n);  // warm-up
+  cuda_check(cudaGetLastError(), "launch of the copy benchmark");
   std::vector<double> rates;
   for (int r = 0; r < reps; ++r) {
     cudaEventRecord(start);

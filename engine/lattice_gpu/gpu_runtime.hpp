@@ -13,6 +13,7 @@ struct GpuDevice {
   int index = 0;  // CUDA's index among the visible devices
   std::string name;
   double memory_gib = 0;
+  double free_gib = 0;  // free when queried (other processes may hold the rest)
   int compute_major = 0, compute_minor = 0;
 };
 
@@ -26,8 +27,12 @@ bool built_with_cuda();
 // The GPUs this process can run on; with none, the reason (no CUDA in the
 // build, no driver, no device visible, a device too old for the build's code).
 GpuQuery query_gpus();
+// Makes the first usable GPU the current one for this thread (what every
+// allocation and launch of the back-end uses) and returns it; throws with
+// the reason when there is none.
+GpuDevice use_first_gpu();
 
-// Device-to-device copy bandwidth of GPU 0 (bytes read + bytes written per
+// Device-to-device copy bandwidth of the current GPU (bytes read + bytes written per
 // second, GB/s): the roofline of a memory-bound kernel, measured with a copy
 // of `bytes` repeated `reps` times; the median of the repetitions.
 double measure_copy_bandwidth_gbs(std::size_t bytes, int reps);

@@ -109,6 +109,20 @@ void read_checkpoint(const fs::path& file, FluidLattice<Real>& fluid, const case
 
 template <class Real>
 RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
+  // On a GPU the lattice steps there, and `fluid` below is the host mirror
+  // that the checkpoints, snapshots and final observables read: brought up to
+  // date by a download before each read, so they are the CPU run's code
+  // unchanged. The GPU's memory is taken before the output folder is
+  // touched, so a GPU that cannot hold the lattice refuses the run up front.
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
+  if (c.device == cases::Device::cuda) {
+    try {
+      device = std::make_unique<gpu::GpuFluidLattice<Real>>(c.size, c.relaxation);
+    } catch (const std::exception& e) {
+      throw input::InputError(std::string("device = \"cuda\": ") + e.what() +
+                              "; run on the CPU with --device cpu");
+    }
+  }
   RunShell shell(o, c.to_json(), c.warnings, c.run.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
   RunLog& log = shell.log();
@@ -136,21 +150,16 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
     base.momentum = fluid.total_momentum();
     base.amplitude = wave_amplitude(fluid, c);
   }
-  // On a GPU the lattice steps there, and `fluid` is the host mirror that the
-  // checkpoints, snapshots and final observables read: brought up to date by
-  // a download before each read, so they are the CPU run's code unchanged.
-  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
   nlohmann::json device_record;
-  if (c.device == cases::Device::cuda) {
-    device = std::make_unique<gpu::GpuFluidLattice<Real>>(c.size, c.relaxation);
+  if (device) {
     device->upload(fluid);
-    const gpu::GpuQuery q = gpu::query_gpus();
+    const gpu::GpuDevice& g = device->gpu();
     device_record = {{"kind", "cuda"},
-                     {"name", q.devices.front().name},
-                     {"memory_gib", q.devices.front().memory_gib},
-                     {"compute_capability", std::to_string(q.devices.front().compute_major) + "." +
-                                                std::to_string(q.devices.front().compute_minor)}};
-    log.info("lattice on GPU " + q.devices.front().name);
+                     {"name", g.name},
+                     {"memory_gib", g.memory_gib},
+                     {"compute_capability",
+                      std::to_string(g.compute_major) + "." + std::to_string(g.compute_minor)}};
+    log.info("lattice on GPU " + std::to_string(g.index) + ", " + g.name);
   }
   const auto time_step = [&] { return device ? device->time_step() : fluid.time_step(); };
   const auto total_mass = [&] { return device ? device->total_mass() : fluid.total_mass(); };
@@ -180,8 +189,12 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   while (time_step() < c.run.steps) {
     stages.run(fluid_stage, [&] {
       if (!device) return fluid.step();
+      // Steps queue on the GPU; waiting for them at each health check keeps
+      // the stage's time the steps' own (not their launches') without a
+      // wait per step. Reads between (snapshots, checkpoints) wait in theirs.
       device->step();
-      device->synchronize();  // the stage's time is the step's, not its launch's
+      if (device->time_step() % health_every == 0 || device->time_step() == c.run.steps)
+        device->synchronize();
     });
     const long t = time_step();
 
