@@ -103,8 +103,7 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
         {"worst_drift", extremes.mass_drift},
         {"relative_to_liquid_mass", extremes.mass_drift / std::max(1e-300, extremes.mass_first)},
         {"what",
-         "largest |liquid mass (sum of rho over every cell) - its first sample| since this "
-         "invocation started"}};
+         "largest |liquid mass (sum of rho over every cell) - its first sample| over the run"}};
     if (modules.spheres_move)
       obs["momentum_balance"] = {
           {"worst_drift", worst_momentum_drift},
@@ -131,8 +130,8 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
   }
   if (modules.spheres_move) obs["max_sphere_speed"] = extremes.sphere_speed;
   obs["max_speeds_what"] =
-      "largest speeds in lattice units at the samples (every protocol.sample_every) since this "
-      "invocation started: max_liquid_speed |u| over every cell, "
+      "largest speeds in lattice units at the samples (every protocol.sample_every) over the "
+      "run: max_liquid_speed |u| over every cell, "
       "max_liquid_speed_outside_spheres over the cells outside every sphere, max_liquid_Mach = "
       "max_liquid_speed sqrt(3), max_sphere_speed |u_p|";
   Distributions dist;

@@ -28,21 +28,6 @@ struct StatisticsSummary {
   Distributions distributions;
 };
 
-// The largest values seen at the samples (every protocol.sample_every) since
-// this invocation of the run started (not checkpointed: a resumed run reports
-// its own part, as the coupling monitor's worst window does).
-struct RunExtremes {
-  double momentum_drift = 0;  // |momentum balance - its first sample| (moving spheres, liquid)
-  double liquid_speed = 0;    // |u| over every cell, lattice units (with a liquid)
-  double liquid_speed_outside_spheres = 0;  // |u| over the cells outside every sphere
-  double sphere_speed = 0;                  // |u_p| (moving spheres)
-  // the liquid mass (sum of rho over every cell) at the first sample and its
-  // largest deviation from it since (with a liquid)
-  double mass_first = 0;
-  bool mass_first_set = false;
-  double mass_drift = 0;
-};
-
 StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState& s,
                             const Protocol& protocol, const events::DirectInteractions& contacts,
                             const RunExtremes& extremes);

@@ -84,8 +84,8 @@ std::string health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
 // wrong when the liquid is no longer healthy, else empty.
 template <class Real>
 std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
-                        const Protocol& protocol, SphereRunState& s, int slabs,
-                        RunExtremes& extremes) {
+                        const Protocol& protocol, SphereRunState& s, int slabs) {
+  RunExtremes& extremes = s.extremes;
   const double a = c.numerics.radius_cells;
   const double mass = s.spheres.mass();
   const spheres::PeriodicBox& box = step.box();
@@ -219,7 +219,6 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                             protocol.expected_total(s.step), cells, c.protocol.progress_every_s);
   shell.set_first_step(s.step);
   bool done = protocol.done(s.step);
-  RunExtremes extremes;
 
   auto fail = [&](const std::string& what) {
     return shell.blown_up("step " + std::to_string(s.step) + " (t U_inf/a = " +
@@ -238,7 +237,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     if (s.step % d.sample == 0) {
       {
         const auto timing = stages.time(observables_stage);
-        const std::string sick = take_sample(c, step, protocol, s, slabs, extremes);
+        const std::string sick = take_sample(c, step, protocol, s, slabs);
         if (!sick.empty()) return fail(sick);
       }
       if (protocol.advance(s.step, s.series[protocol.stationarity_signal()], step.contacts(),
@@ -291,7 +290,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   progress.finish(s.step);
 
   // ---- output and result.json ----------------------------------------------------
-  StatisticsSummary summary = summarise(c, s, protocol, step.contacts(), extremes);
+  StatisticsSummary summary = summarise(c, s, protocol, step.contacts(), s.extremes);
   if (const CouplingMonitor* m = step.coupling())
     summary.observables["coupling_oscillation"] = {
         {"worst_window", m->worst_window()},
