@@ -41,8 +41,10 @@ LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
   const lattice::ForceFieldView<const Real> field = fluid.force_field_if_set();
   const Real* field_x = field.component[0];
   double velocity_sum = 0, all_cells_sum = 0, momentum = 0, mass = 0;
+  double max_speed2 = 0, max_liquid_speed2 = 0;
   long liquid = 0;
-#pragma omp parallel reduction(+ : velocity_sum, all_cells_sum, momentum, mass, liquid)
+#pragma omp parallel reduction(+ : velocity_sum, all_cells_sum, momentum, mass, liquid) \
+    reduction(max : max_speed2, max_liquid_speed2)
   {
     std::vector<double> rho(static_cast<std::size_t>(e.nx)), ux(rho.size()), uy(rho.size()),
         uz(rho.size());
@@ -53,13 +55,23 @@ LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
       fluid.macroscopic_row_without_force_field(0, e.nx, y, z, rho.data(), ux.data(), uy.data(),
                                                 uz.data());
       const Real* row_field_x = field_x ? field.row(0, row) : nullptr;
+      const Real* row_field_y = field_x ? field.row(1, row) : nullptr;
+      const Real* row_field_z = field_x ? field.row(2, row) : nullptr;
       for (int x = 0; x < e.nx; ++x) {
         momentum += rho[x] * ux[x] - 0.5 * body_x;
         mass += rho[x];
         const double force = row_field_x ? static_cast<double>(row_field_x[x]) : 0.0;
         const double u = ux[x] + 0.5 * force / rho[x];
+        const double v =
+            uy[x] + (row_field_y ? 0.5 * static_cast<double>(row_field_y[x]) / rho[x] : 0.0);
+        const double w =
+            uz[x] + (row_field_z ? 0.5 * static_cast<double>(row_field_z[x]) / rho[x] : 0.0);
+        // not finite after a blow-up: NaN never wins a comparison, so the mass tells
+        const double speed2 = u * u + v * v + w * w;
+        if (speed2 > max_speed2) max_speed2 = speed2;
         all_cells_sum += u;
         if (solid[static_cast<std::size_t>(row * e.nx + x)]) continue;
+        if (speed2 > max_liquid_speed2) max_liquid_speed2 = speed2;
         velocity_sum += u;
         ++liquid;
       }
@@ -71,6 +83,8 @@ LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
   out.mean_velocity_x_all_cells = all_cells_sum / static_cast<double>(e.cells());
   out.lattice_momentum_x = momentum;
   out.mass = mass;
+  out.max_speed = std::sqrt(max_speed2);
+  out.max_speed_outside_spheres = std::sqrt(max_liquid_speed2);
   return out;
 }
 

@@ -28,6 +28,11 @@ struct LiquidAverages {
   // half-force shift (what the momentum balance conserves, sphere_dynamics.hpp).
   double lattice_momentum_x = 0;
   double mass = 0;  // sum of rho over every cell; not finite after a blow-up
+  // The largest speed |u| (all three components, each cell's whole half force
+  // included), over every cell and over the liquid cells only: what sets the
+  // lattice Mach number |u| / c_s (docs/accuracy-cost.md, "The lattice Mach number").
+  double max_speed = 0;
+  double max_speed_outside_spheres = 0;
 };
 
 // `solid` is scratch space (one byte per cell), reused between calls.

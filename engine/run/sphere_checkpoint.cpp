@@ -94,6 +94,12 @@ void write_checkpoint(const fs::path& dir, const cases::SuspensionCase& c, const
     f.set_attribute("/", "momentum_initial", s.momentum_initial);
     f.set_attribute("/", "momentum_initial_set", static_cast<std::int64_t>(s.momentum_initial_set));
     f.set_attribute("/", "wall_s", wall_s);
+    const RunExtremes& e = s.extremes;
+    const std::vector<double> extremes = {
+        e.momentum_drift, e.liquid_speed, e.liquid_speed_outside_spheres,
+        e.sphere_speed,   e.mass_first,   e.mass_first_set ? 1.0 : 0.0,
+        e.mass_drift};
+    f.write("/extremes", {extremes.size()}, extremes.data());
     f.close();
   }
   tmp.commit();
@@ -169,6 +175,20 @@ void read_checkpoint(const fs::path& file, const cases::SuspensionCase& c, Spher
   s.momentum_initial = f.attribute_double("/", "momentum_initial");
   s.momentum_initial_set = f.attribute_int("/", "momentum_initial_set") != 0;
   s.wall_s = f.attribute_double("/", "wall_s");
+  // checkpoints written before the extremes were recorded: they count from here
+  if (f.exists("/extremes")) {
+    const auto e = f.read<double>("/extremes");
+    if (e.size() != 7)
+      throw std::runtime_error(file.string() + ": /extremes holds " + std::to_string(e.size()) +
+                               " values, expected 7");
+    s.extremes = {.momentum_drift = e[0],
+                  .liquid_speed = e[1],
+                  .liquid_speed_outside_spheres = e[2],
+                  .sphere_speed = e[3],
+                  .mass_first = e[4],
+                  .mass_first_set = e[5] != 0,
+                  .mass_drift = e[6]};
+  }
   protocol.restore_well(contacts);
   contacts.set_attached_pairs(attached);
   contacts.set_counters(counters);

@@ -54,7 +54,8 @@ nlohmann::json steady(const std::vector<double>& samples) {
 
 StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState& s,
                             const Protocol& protocol, const events::DirectInteractions& contacts,
-                            double worst_momentum_drift) {
+                            const RunExtremes& extremes) {
+  const double worst_momentum_drift = extremes.momentum_drift;
   const cases::SceneModules& modules = cases::modules_of(c.scene);
   const double a = c.numerics.radius_cells;
   const double mass = s.spheres.mass();
@@ -94,6 +95,15 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
       ref["sangani_acrivos_K"] = calibration::sangani_acrivos_drag(2 * a / c.derived.box.nx);
     }
     obs["references"] = ref;
+    // the lattice Mach number the run reached: |u| / c_s, c_s = 1 / sqrt(3)
+    obs["max_liquid_speed"] = extremes.liquid_speed;
+    obs["max_liquid_speed_outside_spheres"] = extremes.liquid_speed_outside_spheres;
+    obs["max_liquid_Mach"] = extremes.liquid_speed * std::sqrt(3.0);
+    obs["mass_balance"] = {
+        {"worst_drift", extremes.mass_drift},
+        {"relative_to_liquid_mass", extremes.mass_drift / std::max(1e-300, extremes.mass_first)},
+        {"what",
+         "largest |liquid mass (sum of rho over every cell) - its first sample| over the run"}};
     if (modules.spheres_move)
       obs["momentum_balance"] = {
           {"worst_drift", worst_momentum_drift},
@@ -118,6 +128,12 @@ StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState
           (collisions.back() - collisions.front()) / c.derived.sphere_count / span;
     }
   }
+  if (modules.spheres_move) obs["max_sphere_speed"] = extremes.sphere_speed;
+  obs["max_speeds_what"] =
+      "largest speeds in lattice units at the samples (every protocol.sample_every) over the "
+      "run: max_liquid_speed |u| over every cell, "
+      "max_liquid_speed_outside_spheres over the cells outside every sphere, max_liquid_Mach = "
+      "max_liquid_speed sqrt(3), max_sphere_speed |u_p|";
   Distributions dist;
   const double n_samples = static_cast<double>(window(column::step).size());
   dist.p.resize(s.size_distribution_sum.size());

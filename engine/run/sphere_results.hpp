@@ -28,11 +28,9 @@ struct StatisticsSummary {
   Distributions distributions;
 };
 
-// `worst_momentum_drift`: the largest |momentum balance - its first sample|
-// seen (scenes whose spheres move in a liquid).
 StatisticsSummary summarise(const cases::SuspensionCase& c, const SphereRunState& s,
                             const Protocol& protocol, const events::DirectInteractions& contacts,
-                            double worst_momentum_drift);
+                            const RunExtremes& extremes);
 
 // The steady averages among `observables` whose window still drifts: listed,
 // and said in the log, so that nobody reads their means as steady-state

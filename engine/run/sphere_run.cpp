@@ -85,8 +85,8 @@ std::string health(const spheres::SphereSet& s, const spheres::PeriodicBox& box,
 // wrong when the liquid is no longer healthy, else empty.
 template <class Real>
 std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
-                        const Protocol& protocol, SphereRunState& s, int slabs,
-                        double& worst_momentum_drift) {
+                        const Protocol& protocol, SphereRunState& s, int slabs) {
+  RunExtremes& extremes = s.extremes;
   const double a = c.numerics.radius_cells;
   const double mass = s.spheres.mass();
   const spheres::PeriodicBox& box = step.box();
@@ -98,6 +98,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
   for (const auto& v : s.spheres.velocity) {
     kinetic += 0.5 * mass * v.squaredNorm();
     sphere_mean += v;
+    extremes.sphere_speed = std::max(extremes.sphere_speed, v.norm());
   }
   sphere_mean /= static_cast<double>(s.spheres.size());
   const SphereSample row{.step = static_cast<double>(s.step),
@@ -114,6 +115,14 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
     const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
     std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a, l.mass);
     if (!sick.empty()) return sick;
+    if (!extremes.mass_first_set) {
+      extremes.mass_first = l.mass;
+      extremes.mass_first_set = true;
+    }
+    extremes.mass_drift = std::max(extremes.mass_drift, std::abs(l.mass - extremes.mass_first));
+    extremes.liquid_speed = std::max(extremes.liquid_speed, l.max_speed);
+    extremes.liquid_speed_outside_spheres =
+        std::max(extremes.liquid_speed_outside_spheres, l.max_speed_outside_spheres);
     const double U = observables::superficial_slip_velocity(l.mean_velocity_x, sphere_mean.x(),
                                                             c.derived.phi_realised);
     // lattice momentum + sum (m_p u_p - P_in), or with the rigid-body inside
@@ -146,7 +155,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
         .liquid_velocity_all_cells = l.mean_velocity_x_all_cells,
         .F_all_cells = observables::dimensionless_drag(body, a, c.derived.phi_realised,
                                                        c.numerics.viscosity, U_all)};
-    worst_momentum_drift = std::max(worst_momentum_drift, std::abs(drift));
+    extremes.momentum_drift = std::max(extremes.momentum_drift, std::abs(drift));
     s.series.append(row, &liquid_row);
   } else {
     s.series.append(row);
@@ -219,7 +228,6 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                             protocol.expected_total(s.step), cells, c.protocol.progress_every_s);
   shell.set_first_step(s.step);
   bool done = protocol.done(s.step);
-  double worst_momentum_drift = 0;
 
   auto fail = [&](const std::string& what) {
     return shell.blown_up("step " + std::to_string(s.step) + " (t U_inf/a = " +
@@ -238,7 +246,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     if (s.step % d.sample == 0) {
       {
         const auto timing = stages.time(observables_stage);
-        const std::string sick = take_sample(c, step, protocol, s, slabs, worst_momentum_drift);
+        const std::string sick = take_sample(c, step, protocol, s, slabs);
         if (!sick.empty()) return fail(sick);
       }
       if (protocol.advance(s.step, s.series[protocol.stationarity_signal()], step.contacts(),
@@ -291,7 +299,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   progress.finish(s.step);
 
   // ---- output and result.json ----------------------------------------------------
-  StatisticsSummary summary = summarise(c, s, protocol, step.contacts(), worst_momentum_drift);
+  StatisticsSummary summary = summarise(c, s, protocol, step.contacts(), s.extremes);
   if (const CouplingMonitor* m = step.coupling())
     summary.observables["coupling_oscillation"] = {
         {"worst_window", m->worst_window()},

@@ -11,6 +11,22 @@
 
 namespace flocsim::run {
 
+// The largest values seen at the samples (every protocol.sample_every) over
+// the run; checkpointed, so that a resumed run reports the same as one that
+// ran straight through (from a checkpoint written before they were, they
+// count from the resume).
+struct RunExtremes {
+  double momentum_drift = 0;  // |momentum balance - its first sample| (moving spheres, liquid)
+  double liquid_speed = 0;    // |u| over every cell, lattice units (with a liquid)
+  double liquid_speed_outside_spheres = 0;  // |u| over the cells outside every sphere
+  double sphere_speed = 0;                  // |u_p| (moving spheres)
+  // the liquid mass (sum of rho over every cell) at the first sample and its
+  // largest deviation from it since (with a liquid)
+  double mass_first = 0;
+  bool mass_first_set = false;
+  double mass_drift = 0;
+};
+
 struct SphereRunState {
   spheres::SphereSet spheres;
   long step = 0;
@@ -22,6 +38,7 @@ struct SphereRunState {
   // momentum balance of liquid + spheres (scenes whose spheres move freely)
   double momentum_initial = 0;
   bool momentum_initial_set = false;
+  RunExtremes extremes;
 
   explicit SphereRunState(bool with_liquid) : series(with_liquid) {}
 };

@@ -102,6 +102,51 @@ TEST(LiquidAverages, PrescribedFieldFloat) {
   prescribed_field<float>(1e-4);
 }
 
+// The largest speed (the lattice Mach number's |u|): all three components,
+// each with its cell's whole half force (body force and the per-cell field in
+// y and z too), over every cell and over the liquid cells only.
+template <class Real>
+void largest_speed(double tolerance) {
+  const double f = 2e-5, g = 3e-4;
+  lattice::FluidLattice<Real> fluid(kExtent, {0.1, 0.25});
+  fluid.set_body_force({f, 0, 0});
+  fluid.enable_force_field();
+  const auto solid = brute_force_solid(kExtent, kCentres, kRadius);
+  auto is_solid = [&](int x, int y, int z) {
+    return solid[static_cast<std::size_t>(x + kExtent.nx * (y + kExtent.ny * z))] != 0;
+  };
+  for (long c = 0; c < kExtent.cells(); ++c)
+    if (solid[static_cast<std::size_t>(c)]) {
+      fluid.force_field().component[1][c] = static_cast<Real>(g);
+      fluid.force_field().component[2][c] = static_cast<Real>(-g);
+    }
+  // one fast liquid cell, away from every sphere
+  const int fx = 6, fy = 2, fz = 2;
+  ASSERT_FALSE(is_solid(fx, fy, fz));
+  fluid.initialise_equilibrium([&](int x, int y, int z) {
+    if (x == fx && y == fy && z == fz) return lattice::Macroscopic{1.0, {0.0, -0.05, 0.03}};
+    if (is_solid(x, y, z)) return lattice::Macroscopic{1.0, {-0.07, 0.01, 0.0}};
+    return lattice::Macroscopic{1.0, {0.013, 0.02, -0.01}};
+  });
+  spheres::SphereSet s;
+  s.radius = kRadius;
+  s.resize(kCentres.size());
+  s.position = kCentres;
+  std::vector<std::uint8_t> scratch;
+  const LiquidAverages l = liquid_averages(fluid, s, scratch);
+  const double inside = std::sqrt(0.07 * 0.07 + 0.01 * 0.01);  // 0.0707
+  const double fast = std::sqrt(0.05 * 0.05 + 0.03 * 0.03);    // 0.0583
+  EXPECT_NEAR(l.max_speed, inside, tolerance * inside);
+  EXPECT_NEAR(l.max_speed_outside_spheres, fast, tolerance * fast);
+}
+
+TEST(LiquidAverages, LargestSpeedDouble) {
+  largest_speed<double>(1e-12);
+}
+TEST(LiquidAverages, LargestSpeedFloat) {
+  largest_speed<float>(1e-4);
+}
+
 TEST(ReferenceCorrelations, HandWorkedValues) {
   // Beetstra at phi = 0.2, Re = 10: Stokes part 10 * 0.2 / 0.64 + 0.64 (1 + 1.5 sqrt 0.2)
   // = 3.125 + 1.069325 = 4.194325; inertial part 0.413 * 10 / (24 * 0.64) * (1.25 + 0.48 +

@@ -1,0 +1,99 @@
+// The paper's grid at its corners (sweeps/corners*.json: phi 0.12/0.32 x
+// Re_inf 6/72 x du/U_inf 0/0.03, and phi 0.12, Re_inf 6, du 0.05), one file
+// per fidelity preset: `flocsim sweep plan` (sizes only, nothing timed or
+// stepped) refuses at each preset exactly the corners that docs/accuracy-cost.md
+// ("The grid's corners") says it cannot run, with the run's own message naming
+// what would work, and accepts the rest.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+#include <tuple>
+
+#include "orchestrator/plan.hpp"
+#include "orchestrator/sweep.hpp"
+
+namespace orc = flocsim::orchestrator;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+namespace {
+
+using Corner = std::tuple<double, double, double>;  // phi, Re_inf, du/U_inf
+
+orc::SweepPlan plan_of(const std::string& file) {
+  orc::PlanOptions o;
+  o.measure_steps = 0;  // parse and size only
+  return orc::plan_sweep(orc::read_sweep_file(std::string(FLOCSIM_SOURCE_DIR) + "/sweeps/" + file),
+                         o);
+}
+
+Corner corner_of(const orc::PlannedRun& r) {
+  const auto& c = r.point.case_json;
+  return {c["phi"].get<double>(), c["Re_inf"].get<double>(), c["du_over_Uinf"].get<double>()};
+}
+
+TEST(GridCorners, EachPresetRefusesExactlyTheCornersItCannotRun) {
+  // By hand (docs/numerics.md): Re_inf <= 2 a U_inf / nu with U_inf <= 0.07 (Mach)
+  // and nu >= 0.01 below a = 6, 0.005 from a = 6: 56 at draft (a = 4), 168 at
+  // standard and paper (a = 6). So draft refuses its four Re_inf 72 corners and
+  // nothing else; standard (U_inf 0.04: nu 0.08 at Re_inf 6, 0.0067 at 72) and
+  // paper (U_inf 0.02; at Re_inf 72 nu would be 0.0033, so the floor raises U_inf
+  // to 0.03) refuse none. The draft corners at Re_inf 6 ran (140 a/U_inf, none
+  // blew up or oscillated: docs/accuracy-cost.md), so nothing else is refused.
+  const std::set<Corner> grid = {{0.12, 6, 0},     {0.12, 6, 0.03},  {0.12, 72, 0},
+                                 {0.12, 72, 0.03}, {0.32, 6, 0},     {0.32, 6, 0.03},
+                                 {0.32, 72, 0},    {0.32, 72, 0.03}, {0.12, 6, 0.05}};
+  const std::set<Corner> draft_refuses = {
+      {0.12, 72, 0}, {0.12, 72, 0.03}, {0.32, 72, 0}, {0.32, 72, 0.03}};
+  for (const std::string preset : {"draft", "standard", "paper"}) {
+    const std::string suffix = preset == "draft" ? "" : "-" + preset;
+    std::set<Corner> seen, refused;
+    for (const std::string file :
+         {"corners" + suffix + ".json", "corners-extra" + suffix + ".json"}) {
+      const orc::SweepPlan plan = plan_of(file);
+      for (const orc::PlannedRun& r : plan.runs) {
+        EXPECT_EQ(r.point.case_json["fidelity"], preset) << file;
+        const Corner k = corner_of(r);
+        EXPECT_TRUE(seen.insert(k).second) << file << ": " << r.point.point.dump() << " twice";
+        if (r.refused.empty()) continue;
+        refused.insert(k);
+        EXPECT_THAT(r.refused, AllOf(HasSubstr("Re_inf <= 2 a U_inf / nu = 56"),
+                                     HasSubstr("raise numerics.a_over_dx to at least 6")))
+            << preset << " " << r.point.point.dump();
+      }
+      EXPECT_EQ(plan.refused, static_cast<int>(std::count_if(
+                                  plan.runs.begin(), plan.runs.end(),
+                                  [](const orc::PlannedRun& r) { return !r.refused.empty(); })));
+    }
+    EXPECT_EQ(seen, grid) << preset;
+    EXPECT_EQ(refused, preset == "draft" ? draft_refuses : std::set<Corner>{}) << preset;
+  }
+}
+
+TEST(GridCorners, TheWindowsAreAsDescribed) {
+  // The sweep files' descriptions promise 140 a/U_inf (8000 steps) at draft and
+  // 40 a/U_inf at standard and paper (6000 and 12000 steps; 8000 at Re_inf 72 on
+  // the paper preset, where the floor raises U_inf to 0.03): stage 1 of exactly
+  // 20, no settling, then the statistics. The protocol rounds each stage to
+  // whole samples (every 0.5 a/U_inf), which adds up to 1 % with the well.
+  auto steps = [](const std::string& file, const Corner& k) {
+    for (const orc::PlannedRun& r : plan_of(file).runs)
+      if (corner_of(r) == k) {
+        EXPECT_EQ(r.size.steps_min, r.size.steps_max) << file;
+        return r.size.steps_min;
+      }
+    ADD_FAILURE() << file << ": no such corner";
+    return -1L;
+  };
+  EXPECT_EQ(steps("corners.json", {0.12, 6, 0}), 8033);
+  EXPECT_EQ(steps("corners.json", {0.12, 6, 0.03}), 8062);
+  EXPECT_EQ(steps("corners-extra.json", {0.12, 6, 0.05}), 8062);
+  EXPECT_EQ(steps("corners-standard.json", {0.32, 72, 0}), 6000);
+  EXPECT_EQ(steps("corners-paper.json", {0.12, 6, 0.03}), 12150);
+  EXPECT_EQ(steps("corners-paper.json", {0.32, 72, 0.03}), 8100);
+}
+
+}  // namespace
