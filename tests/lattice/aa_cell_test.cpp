@@ -17,20 +17,13 @@
 
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
+#include "tests/lattice/lattice_probes.hpp"
 
 namespace flocsim::lattice {
 namespace {
 
-// The populations of `fluid` copied into a plain slot array (stride = cells).
-template <class Real>
-std::vector<Real> slots_of(const FluidLattice<Real>& fluid) {
-  std::vector<Real> all, one;
-  for (int i = 0; i < d3q19::kQ; ++i) {
-    fluid.save_slots(i, one);
-    all.insert(all.end(), one.begin(), one.end());
-  }
-  return all;
-}
+// The populations as a plain slot array (stride = cells).
+using flocsim::testing::slots_of;
 
 template <class Real>
 CollisionConstants<Real> constants_of(const Relaxation& r) {

@@ -2,6 +2,8 @@
 // Test-side readers of a lattice, built only from its public per-cell queries
 // (population(), the force field view): independent references for the
 // optimised row readers the engine uses.
+#include <vector>
+
 #include "engine/lattice/fluid_lattice.hpp"
 
 namespace flocsim::testing {
@@ -23,6 +25,18 @@ lattice::Macroscopic macroscopic_without_force_field(const lattice::FluidLattice
   rho += 1.0;
   const lattice::Vector3 F = fluid.body_force();
   return {rho, {(j[0] + 0.5 * F.x) / rho, (j[1] + 0.5 * F.y) / rho, (j[2] + 0.5 * F.z) / rho}};
+}
+
+// Every population slot of the lattice as stored (direction after direction,
+// cells() values each): what a bit-for-bit comparison of two lattices reads.
+template <class Real>
+std::vector<Real> slots_of(const lattice::FluidLattice<Real>& fluid) {
+  std::vector<Real> all, one;
+  for (int i = 0; i < d3q19::kQ; ++i) {
+    fluid.save_slots(i, one);
+    all.insert(all.end(), one.begin(), one.end());
+  }
+  return all;
 }
 
 }  // namespace flocsim::testing

@@ -21,6 +21,7 @@
 
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "tests/lattice/lattice_probes.hpp"
 
 namespace flocsim::gpu {
 namespace {
@@ -44,15 +45,7 @@ void initialise_shear_wave(FluidLattice<Real>& fluid, double U0, unsigned seed) 
   });
 }
 
-template <class Real>
-std::vector<Real> slots_of(const FluidLattice<Real>& fluid) {
-  std::vector<Real> all, one;
-  for (int i = 0; i < d3q19::kQ; ++i) {
-    fluid.save_slots(i, one);
-    all.insert(all.end(), one.begin(), one.end());
-  }
-  return all;
-}
+using flocsim::testing::slots_of;
 
 double largest_difference(const std::vector<double>& a, const std::vector<double>& b) {
   double worst = 0;

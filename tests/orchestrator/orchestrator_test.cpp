@@ -102,6 +102,18 @@ class Orchestrator : public ::testing::Test {
       EXPECT_EQ(db.count_results(r.id), r.status == RunState::kCompleted ? 1 : 0) << r.case_json;
   }
 
+  // `ro` shows `rw` read-only (a bind mount); false where that cannot be
+  // done (not root), with nothing left mounted.
+  static bool mount_read_only(const fs::path& rw, const fs::path& ro) {
+    if (::geteuid() == 0 &&
+        std::system(("mount --bind " + rw.string() + " " + ro.string() +
+                     " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
+                        .c_str()) == 0)
+      return true;
+    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+    return false;
+  }
+
   fs::path dir_;
   std::string db_;
 };
@@ -771,13 +783,8 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
                             FAKE_WORKER_EXE}))
                 .code,
             0);
-  if (::geteuid() != 0 ||
-      std::system(("mount --bind " + rw.string() + " " + ro.string() +
-                   " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
-                      .c_str()) != 0) {
-    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+  if (!mount_read_only(rw, ro))
     GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
-  }
   const std::string ro_db = (ro / "results.db").string();
   const t::Output q = t::run(flocsim({"query", "--db", ro_db, "--format", "csv"}));
   const t::Output st = t::run(flocsim({"sweep", "status", "--db", ro_db}));
@@ -802,13 +809,8 @@ TEST_F(Orchestrator, CancelReadsAReadOnlyDatabase) {
                             FAKE_WORKER_EXE}))
                 .code,
             0);
-  if (::geteuid() != 0 ||
-      std::system(("mount --bind " + rw.string() + " " + ro.string() +
-                   " && mount -o remount,ro,bind " + ro.string() + " 2>/dev/null")
-                      .c_str()) != 0) {
-    std::system(("umount " + ro.string() + " 2>/dev/null").c_str());
+  if (!mount_read_only(rw, ro))
     GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
-  }
   const t::Output c = t::run(flocsim({"sweep", "cancel", "--db", (ro / "results.db").string()}));
   std::system(("umount " + ro.string()).c_str());
   EXPECT_EQ(c.code, 0) << c.out;
