@@ -120,8 +120,9 @@ int main(int argc, char** argv) {
     return 77;
   }
   const gpu::GpuDevice& d = q.devices.front();
-  std::printf("GPU %s (%.0f GiB, compute capability %d.%d); medians of %d repetitions of %d steps\n",
-              d.name.c_str(), d.memory_gib, d.compute_major, d.compute_minor, reps, steps);
+  std::printf(
+      "GPU %s (%.0f GiB, compute capability %d.%d); medians of %d repetitions of %d steps\n",
+      d.name.c_str(), d.memory_gib, d.compute_major, d.compute_minor, reps, steps);
   std::printf("%-15s %-9s %-10s %10s %14s %12s\n", "size", "precision", "force", "MLUPS",
               "copy GB/s", "of roofline");
   nlohmann::json all = nlohmann::json::array();

@@ -36,7 +36,7 @@ struct PoolOptions {
   double poll_s = 0.2;   // how often children are checked
   double grace_s = 120;  // how long a stopping worker may take to checkpoint
   std::string backend = "local";
-  std::string job_id;           // backend job id recorded in attempts
+  std::string job_id;  // backend job id recorded in attempts
   // "cpu" or "cuda": passed to every worker as --device; empty: each case's
   // own "device". With cuda and `gpus` > 1, each worker gets the GPU that
   // runs the fewest workers (CUDA_VISIBLE_DEVICES), so jobs > gpus shares them.

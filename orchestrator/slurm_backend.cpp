@@ -198,8 +198,8 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
                              "), though squeue answers; install Slurm's client commands "
                              "(slurm-client) or add their folder to PATH");
   // a GPU per task when the workers run on cuda, unless the sweep says which
-  const std::string gres = !settings.gres.empty() ? settings.gres
-                                                  : (l.device == "cuda" ? "gpu:1" : "");
+  const std::string gres =
+      !settings.gres.empty() ? settings.gres : (l.device == "cuda" ? "gpu:1" : "");
 
   // What to do: claimable runs of the sweep (the tasks claim them for real).
   std::vector<db::RunRecord> to_submit;

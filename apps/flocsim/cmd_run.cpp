@@ -43,8 +43,10 @@ int run_command(const RunArguments& a) {
   if (parsed.fluid_scene && parsed.fluid.device == cases::Device::cuda) {
     const gpu::GpuQuery q = gpu::query_gpus();
     if (q.devices.empty()) {
-      std::fprintf(stderr, "flocsim run: input error in %s: device = \"cuda\": %s; run on the CPU "
-                   "with --device cpu\n", a.case_file.c_str(), q.why_none.c_str());
+      std::fprintf(stderr,
+                   "flocsim run: input error in %s: device = \"cuda\": %s; run on the CPU "
+                   "with --device cpu\n",
+                   a.case_file.c_str(), q.why_none.c_str());
       return kExitBadInput;
     }
     // the populations must fit the GPU's free memory (the host mirror is

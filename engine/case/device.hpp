@@ -13,15 +13,20 @@ namespace flocsim::cases {
 
 enum class Device { cpu, cuda };
 
-inline const char* device_name(Device d) { return d == Device::cuda ? "cuda" : "cpu"; }
+inline const char* device_name(Device d) {
+  return d == Device::cuda ? "cuda" : "cpu";
+}
 
 // The allowed names, for choices and messages.
 inline constexpr const char* kDeviceNames[] = {"cpu", "cuda"};
 
 inline bool parse_device_name(std::string_view name, Device& out) {
-  if (name == "cpu") out = Device::cpu;
-  else if (name == "cuda") out = Device::cuda;
-  else return false;
+  if (name == "cpu")
+    out = Device::cpu;
+  else if (name == "cuda")
+    out = Device::cuda;
+  else
+    return false;
   return true;
 }
 

@@ -68,7 +68,7 @@ FLOCSIM_KERNEL_BODY long aa_next_slot(const AaSlots<Real>& s, int i, int x, int 
 template <class Real>
 FLOCSIM_KERNEL_BODY void aa_load_cell(const AaSlots<Real>& s, int x, int y, int z, bool even,
                                       Real (&f)[d3q19::kQ]) {
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) f[i] = s.base[aa_current_slot(s, i, x, y, z, even)];
 }
 
@@ -80,7 +80,7 @@ FLOCSIM_KERNEL_BODY void aa_update_cell(const AaSlots<Real>& s, int x, int y, in
   Real f[d3q19::kQ];
   aa_load_cell(s, x, y, z, even, f);
   collide(f, Fx, Fy, Fz, k);
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) s.base[aa_next_slot(s, i, x, y, z, even)] = f[i];
 }
 
@@ -90,7 +90,7 @@ template <class Real>
 FLOCSIM_KERNEL_BODY void cell_moments(const Real (&f)[d3q19::kQ], Real Fx, Real Fy, Real Fz,
                                       Real& rho, Real& ux, Real& uy, Real& uz) {
   Real drho = 0;
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) drho += f[i];
   const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
   const Real jy = f[3] - f[4] + f[7] - f[8] - f[9] + f[10] + f[15] - f[16] + f[17] - f[18];

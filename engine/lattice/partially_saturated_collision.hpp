@@ -43,13 +43,13 @@ namespace flocsim::lattice {
 // the density and the momentum density rho u the collision saw.
 template <class Real>
 FLOCSIM_KERNEL_BODY void collide_partially_saturated(Real (&f)[d3q19::kQ], Real Fx, Real Fy,
-                                                       Real Fz, Real eps, Real Vx, Real Vy, Real Vz,
-                                                       const CollisionConstants<Real>& k,
-                                                       Real& rho_out, Real& jx_out, Real& jy_out,
-                                                       Real& jz_out) {
+                                                     Real Fz, Real eps, Real Vx, Real Vy, Real Vz,
+                                                     const CollisionConstants<Real>& k,
+                                                     Real& rho_out, Real& jx_out, Real& jy_out,
+                                                     Real& jz_out) {
   using namespace d3q19;
   Real drho = 0;
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 0; i < kQ; ++i) drho += f[i];
   const Real rho = Real(1) + drho;
   const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
@@ -87,7 +87,7 @@ FLOCSIM_UNROLL
   const Real M_F = Real(3) * (liquid * k.force_minus - Real(0.5) * om * B);
 
   f[0] += -op * f[0] + Real(kWeightRest) * K;
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 1; i < kQ; i += 2) {
     const Real wi = Real(weight_of(i));
     const Real cu = Real(velocity_x(i)) * ux + Real(velocity_y(i)) * uy + Real(velocity_z(i)) * uz;

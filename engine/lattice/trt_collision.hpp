@@ -20,10 +20,10 @@ struct CollisionConstants {
 // place. F is the force density acting on the cell.
 template <class Real>
 FLOCSIM_KERNEL_BODY void collide(Real (&f)[d3q19::kQ], Real Fx, Real Fy, Real Fz,
-                                   const CollisionConstants<Real>& k) {
+                                 const CollisionConstants<Real>& k) {
   using namespace d3q19;
   Real drho = 0;
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) drho += f[i];
   const Real rho = Real(1) + drho;
   const Real jx = f[1] - f[2] + f[7] - f[8] + f[9] - f[10] + f[11] - f[12] + f[13] - f[14];
@@ -43,7 +43,7 @@ FLOCSIM_UNROLL
     f[0] += -k.omega_plus * (f[0] - eq) - k.force_plus * w0 * uF3;
   }
   // Moving populations, one opposite pair (i, i+1) at a time; c = c_i.
-FLOCSIM_UNROLL
+  FLOCSIM_UNROLL
   for (int i = 1; i < kQ; i += 2) {
     const Real wi = Real(weight_of(i));
     const Real cu = Real(velocity_x(i)) * ux + Real(velocity_y(i)) * uy + Real(velocity_z(i)) * uz;

@@ -16,13 +16,21 @@ const char* kNoCuda =
     "again; docs/gpu.md)";
 }
 
-bool built_with_cuda() { return false; }
+bool built_with_cuda() {
+  return false;
+}
 
-GpuQuery query_gpus() { return {{}, kNoCuda}; }
+GpuQuery query_gpus() {
+  return {{}, kNoCuda};
+}
 
-GpuDevice use_first_gpu() { throw std::runtime_error(kNoCuda); }
+GpuDevice use_first_gpu() {
+  throw std::runtime_error(kNoCuda);
+}
 
-double measure_copy_bandwidth_gbs(std::size_t, int) { throw std::runtime_error(kNoCuda); }
+double measure_copy_bandwidth_gbs(std::size_t, int) {
+  throw std::runtime_error(kNoCuda);
+}
 
 template <class Real>
 struct GpuFluidLattice<Real>::Device {};
@@ -45,11 +53,17 @@ void GpuFluidLattice<Real>::step() {}
 template <class Real>
 void GpuFluidLattice<Real>::synchronize() const {}
 template <class Real>
-double GpuFluidLattice<Real>::total_mass() const { return 0; }
+double GpuFluidLattice<Real>::total_mass() const {
+  return 0;
+}
 template <class Real>
-lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const { return {}; }
+lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const {
+  return {};
+}
 template <class Real>
-std::size_t GpuFluidLattice<Real>::bytes_per_cell_update() const { return 0; }
+std::size_t GpuFluidLattice<Real>::bytes_per_cell_update() const {
+  return 0;
+}
 
 template <class Real>
 const GpuDevice& GpuFluidLattice<Real>::gpu() const {

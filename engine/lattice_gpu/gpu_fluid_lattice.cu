@@ -203,8 +203,8 @@ void GpuFluidLattice<Real>::step() {
     aa_step_kernel<Real, true><<<grid, threads>>>(s, even, k, bx, by, bz, device_->force[0],
                                                   device_->force[1], device_->force[2]);
   else
-    aa_step_kernel<Real, false><<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr,
-                                                   nullptr);
+    aa_step_kernel<Real, false>
+        <<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr, nullptr);
   cuda_check(cudaGetLastError(), "launch of the lattice step");
   ++time_step_;
 }
@@ -218,8 +218,8 @@ namespace {
 template <class Real>
 std::vector<double> block_sums(const AaSlots<Real>& s, bool even, lattice::Vector3 body,
                                Real* const (&force)[3], double* partial, int blocks) {
-  moments_sum_kernel<Real><<<blocks, kReductionThreads>>>(s, even, body.x, body.y, body.z,
-                                                          force[0], force[1], force[2], partial);
+  moments_sum_kernel<Real><<<blocks, kReductionThreads>>>(s, even, body.x, body.y, body.z, force[0],
+                                                          force[1], force[2], partial);
   cuda_check(cudaGetLastError(), "launch of the mass and momentum sums");
   std::vector<double> host(4 * static_cast<std::size_t>(blocks));
   cuda_check(cudaMemcpy(host.data(), partial, sizeof(double) * host.size(), cudaMemcpyDeviceToHost),
@@ -231,8 +231,8 @@ std::vector<double> block_sums(const AaSlots<Real>& s, bool even, lattice::Vecto
 template <class Real>
 double GpuFluidLattice<Real>::total_mass() const {
   const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
-  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force, device_->partial,
-                               device_->reduction_blocks);
+  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force,
+                               device_->partial, device_->reduction_blocks);
   double excess = 0;
   for (int b = 0; b < device_->reduction_blocks; ++b) excess += sums[4 * b];
   return static_cast<double>(extent_.cells()) + excess;
@@ -241,8 +241,8 @@ double GpuFluidLattice<Real>::total_mass() const {
 template <class Real>
 lattice::Vector3 GpuFluidLattice<Real>::total_momentum() const {
   const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
-  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force, device_->partial,
-                               device_->reduction_blocks);
+  const auto sums = block_sums(s, time_step_ % 2 == 0, body_force_, device_->force,
+                               device_->partial, device_->reduction_blocks);
   lattice::Vector3 p;
   for (int b = 0; b < device_->reduction_blocks; ++b) {
     p.x += sums[4 * b + 1];

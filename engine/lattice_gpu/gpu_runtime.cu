@@ -9,7 +9,9 @@
 
 namespace flocsim::gpu {
 
-bool built_with_cuda() { return true; }
+bool built_with_cuda() {
+  return true;
+}
 
 GpuQuery query_gpus() {
   GpuQuery q;
@@ -18,10 +20,10 @@ GpuQuery query_gpus() {
   if (status != cudaSuccess || count == 0) {
     // without a driver the runtime says its version is "insufficient"
     const bool no_driver = status == cudaErrorInsufficientDriver;
-    q.why_none = std::string(no_driver ? "no NVIDIA driver on this machine"
-                                       : "no CUDA GPU is visible to this process") +
-                 " (CUDA: " +
-                 (status != cudaSuccess ? cudaGetErrorString(status) : "no device found") + ")";
+    q.why_none =
+        std::string(no_driver ? "no NVIDIA driver on this machine"
+                              : "no CUDA GPU is visible to this process") +
+        " (CUDA: " + (status != cudaSuccess ? cudaGetErrorString(status) : "no device found") + ")";
     if (const char* visible = std::getenv("CUDA_VISIBLE_DEVICES"))
       q.why_none += std::string(", CUDA_VISIBLE_DEVICES=\"") + visible + "\"";
     cudaGetLastError();  // clear the sticky error of a failed query

@@ -6,11 +6,11 @@
 #include <memory>
 
 #include "engine/input/input_reader.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
-#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
-#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/run/lattice_files.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
@@ -166,14 +166,14 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   const auto mirror = [&] {
     if (device) device->download(fluid);
   };
-  log.info(std::string("flocsim ") + kFlocsimVersion + " fluid scene: " +
-           std::to_string(c.size.nx) + " x " + std::to_string(c.size.ny) + " x " +
-           std::to_string(c.size.nz) + " cells, nu = " + std::to_string(c.relaxation.viscosity) +
-           " (tau = " + std::to_string(c.relaxation.tau_plus()) + "), " +
-           (sizeof(Real) == 8 ? "double" : "float") + " precision, " +
-           (device ? std::string("on the GPU") : std::to_string(omp_get_max_threads()) + " threads") +
-           ", " + std::to_string(c.run.steps) +
-           " steps");
+  log.info(
+      std::string("flocsim ") + kFlocsimVersion + " fluid scene: " + std::to_string(c.size.nx) +
+      " x " + std::to_string(c.size.ny) + " x " + std::to_string(c.size.nz) +
+      " cells, nu = " + std::to_string(c.relaxation.viscosity) +
+      " (tau = " + std::to_string(c.relaxation.tau_plus()) + "), " +
+      (sizeof(Real) == 8 ? "double" : "float") + " precision, " +
+      (device ? std::string("on the GPU") : std::to_string(omp_get_max_threads()) + " threads") +
+      ", " + std::to_string(c.run.steps) + " steps");
 
   ProgressReporter progress(log, o.out_dir / "progress.json", fluid.time_step(), c.run.steps,
                             c.size.cells(), c.run.progress_every_s);

@@ -1,8 +1,8 @@
 #include "engine/run/run_shell.hpp"
 
-#include <fstream>
-
 #include <omp.h>
+
+#include <fstream>
 
 #include "engine/output/atomic_file.hpp"
 #include "engine/process/stop_signal.hpp"

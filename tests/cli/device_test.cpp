@@ -22,16 +22,16 @@ TEST_F(Cli, DeviceCudaWithoutAUsableGpuIsRefusedBeforeAnyWork) {
   if (!q.devices.empty()) GTEST_SKIP() << "a GPU is usable here: " << q.devices[0].name;
   t::write_text(dir_ / "case.json", kShearWave);
   const fs::path out = dir_ / "out";
-  const t::Output o = t::run(flocsim({"run", (dir_ / "case.json").string(), "--out", out.string(),
-                                      "--device", "cuda"}));
+  const t::Output o = t::run(
+      flocsim({"run", (dir_ / "case.json").string(), "--out", out.string(), "--device", "cuda"}));
   EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_NE(o.out.find("device = \"cuda\""), std::string::npos) << o.out;
   EXPECT_NE(o.out.find(q.why_none), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("--device cpu"), std::string::npos) << o.out;  // what would work
   EXPECT_FALSE(fs::exists(out)) << "work started: " << out;
   // the same case on the CPU runs, and says where it ran
-  const t::Output cpu = t::run(flocsim({"run", (dir_ / "case.json").string(), "--out",
-                                        out.string(), "--device", "cpu", "--quiet"}));
+  const t::Output cpu = t::run(flocsim(
+      {"run", (dir_ / "case.json").string(), "--out", out.string(), "--device", "cpu", "--quiet"}));
   ASSERT_EQ(cpu.code, 0) << cpu.out;
   const auto result = t::read_json(out / "result.json");
   EXPECT_EQ(result["device"]["kind"], "cpu");
@@ -44,8 +44,8 @@ TEST_F(Cli, SphereScenesRefuseCudaBeforeAnyWork) {
   t::write_text(dir_ / "case.json",
                 R"({"scene": "suspension", "fidelity": "draft", "phi": 0.2, "Re_inf": 6})");
   const fs::path out = dir_ / "out";
-  const t::Output o = t::run(flocsim({"run", (dir_ / "case.json").string(), "--out", out.string(),
-                                      "--device", "cuda"}));
+  const t::Output o = t::run(
+      flocsim({"run", (dir_ / "case.json").string(), "--out", out.string(), "--device", "cuda"}));
   EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_NE(o.out.find("runs on the CPU only"), std::string::npos) << o.out;
   EXPECT_FALSE(fs::exists(out));

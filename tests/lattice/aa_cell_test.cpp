@@ -6,6 +6,8 @@
 // lattice_reference_test.cpp; here they are held to each other, over even
 // and odd steps, with a body force and a per-cell force field, on boxes whose
 // every cell touches the periodic wrap in some direction.
+#include "engine/lattice/aa_cell.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,7 +17,6 @@
 #include <random>
 #include <vector>
 
-#include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "tests/lattice/lattice_probes.hpp"
 

@@ -4,6 +4,7 @@
 // compilers fuse multiply-adds differently. Runs only where a GPU is visible
 // (gpu_test_main.cpp skips otherwise); scripts/device-check.sh runs it.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,13 +12,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
-
-#include <nlohmann/json.hpp>
 
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
@@ -241,12 +239,13 @@ TEST(GpuRun, AGpuCheckpointResumesOnTheCpu) {
   const char* source =
       std::getenv("FLOCSIM_SOURCE_DIR") ? std::getenv("FLOCSIM_SOURCE_DIR") : FLOCSIM_SOURCE_DIR;
   const std::string example = std::string(source) + "/examples/fluid_shear_wave.json";
-  const fs::path base = fs::temp_directory_path() / ("flocsim-gpu-resume-" + std::to_string(getpid()));
+  const fs::path base =
+      fs::temp_directory_path() / ("flocsim-gpu-resume-" + std::to_string(getpid()));
   fs::remove_all(base);
   const auto run = [&](const fs::path& out, const std::string& extra) {
-    return std::system((std::string(exe) + " run " + example + " --out " + out.string() +
-                        " --quiet " + extra)
-                           .c_str());
+    return std::system(
+        (std::string(exe) + " run " + example + " --out " + out.string() + " --quiet " + extra)
+            .c_str());
   };
   ASSERT_NE(run(base / "moved", "--device cuda --stop-after 1501"), 0);  // stopped: exit 3
   ASSERT_EQ(run(base / "moved", "--device cpu --resume"), 0);

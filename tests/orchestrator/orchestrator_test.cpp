@@ -15,8 +15,8 @@
 #include <tuple>
 
 #include "db/results_db.hpp"
-#include "harness.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
+#include "harness.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/plan.hpp"
 #include "orchestrator/sweep.hpp"
@@ -151,7 +151,8 @@ TEST_F(Orchestrator, WorkersOnCudaGetTheirOwnGpuThenShare) {
 }
 
 TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
-  const flocsim::orchestrator::SweepSpec spec = flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 10));
+  const flocsim::orchestrator::SweepSpec spec =
+      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 10));
   ResultsDb db(db_, ResultsDb::Mode::kCreate);
   const flocsim::orchestrator::Registered reg =
       flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
@@ -188,10 +189,10 @@ TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
     sweep["name"] = gres.empty() ? "gpu-default" : "gpu-named";
     if (!gres.empty()) sweep["slurm"]["gres"] = gres;
     t::write_text(dir_ / "sweep.json", sweep.dump());
-    const t::Output o = t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db",
-                                        db_, "--backend", "slurm", "--no-wait", "--device",
-                                        "cuda"}),
-                               {path});
+    const t::Output o =
+        t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db", db_, "--backend",
+                        "slurm", "--no-wait", "--device", "cuda"}),
+               {path});
     ASSERT_EQ(o.code, 0) << o.out;
     std::vector<std::string> args;
     std::istringstream lines(t::read_text(bin / "args"));
@@ -783,8 +784,7 @@ TEST_F(Orchestrator, AReadOnlyDatabaseIsReadAndWritersSaySo) {
                             FAKE_WORKER_EXE}))
                 .code,
             0);
-  if (!mount_read_only(rw, ro))
-    GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
+  if (!mount_read_only(rw, ro)) GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
   const std::string ro_db = (ro / "results.db").string();
   const t::Output q = t::run(flocsim({"query", "--db", ro_db, "--format", "csv"}));
   const t::Output st = t::run(flocsim({"sweep", "status", "--db", ro_db}));
@@ -809,8 +809,7 @@ TEST_F(Orchestrator, CancelReadsAReadOnlyDatabase) {
                             FAKE_WORKER_EXE}))
                 .code,
             0);
-  if (!mount_read_only(rw, ro))
-    GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
+  if (!mount_read_only(rw, ro)) GTEST_SKIP() << "cannot mount a read-only folder here (needs root)";
   const t::Output c = t::run(flocsim({"sweep", "cancel", "--db", (ro / "results.db").string()}));
   std::system(("umount " + ro.string()).c_str());
   EXPECT_EQ(c.code, 0) << c.out;
