@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packs what the GPU machine needs to run the device check into one small
 # folder (the device tool carries at most 64 MiB of ignored paths): the GPU
-# test, the GPU and CPU fluid benchmarks and flocsim itself, built here with
+# tests, the GPU fluid and coupling benchmarks, the CPU fluid benchmark and flocsim itself, built here with
 # the CUDA back-end, and every shared library they load except the C library
 # and the loader, which the machine has (and the CUDA driver, which is its own).
 # Usage: scripts/device-bundle.sh [BUILD_DIR] [BUNDLE_DIR]
@@ -14,7 +14,9 @@ build=${1:-build/release}
 bundle=${2:-build/device-bundle}
 programs=(
   "$build/tests/lattice_gpu/test_gpu_lattice"
+  "$build/tests/coupling_gpu/test_gpu_coupling"
   "$build/bench/bench_fluid_gpu"
+  "$build/bench/bench_coupling_gpu"
   "$build/bench/bench_fluid"
   "$build/apps/flocsim"
 )

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# The device check: on a machine with a GPU, runs the GPU tests, the GPU
-# fluid benchmark (with the device's copy bandwidth measured in the same run),
+# The device check: on a machine with a GPU, runs the GPU tests (lattice and
+# immersed boundary), the GPU fluid benchmark (with the device's copy
+# bandwidth measured in the same run), the GPU coupled-step benchmark (the
+# immersed boundary on the paper's case against the fluid alone),
 # the CPU fluid benchmark on that machine's cores for the speed-up, and the
 # fluid scene at the paper's box size on the GPU and on the CPU, writing every
 # figure into one folder. Sized to finish in under 8 minutes, so a 15-minute
 # device session holds it and a rerun.
 #
-# Time limits per step: 90 + 150 + 60 + 4 x 45 = 480 s at most.
+# Time limits per step: 60 + 60 + 100 + 90 + 45 + 4 x 30 = 475 s at most.
 # Usage (from the repository root, on the GPU machine):
 #   scripts/device-check.sh [BUNDLE] [OUT]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
@@ -59,16 +61,23 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
 cat "$out/machine.txt"
 
 # 1. the GPU against the CPU reference (tests/lattice_gpu)
-step gpu-tests 90 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
+step gpu-tests 60 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
+step gpu-coupling-tests 60 "$bundle/bin/test_gpu_coupling" \
+  --gtest_output="json:$out/gpu-coupling-tests.json"
 
 # 2. the fluid kernel: paper's box and 256^3, float and double, against the
 #    device's copy bandwidth
-step bench-fluid-gpu 150 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
+step bench-fluid-gpu 100 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
   --json "$out/bench-fluid-gpu.json"
+
+# 2b. the coupled step on the paper's case (a = 6, N = 1320): the immersed
+#     boundary's presets' schemes, float and double, against the fluid alone
+step bench-coupling-gpu 90 "$bundle/bin/bench_coupling_gpu" --reps 5 --steps 20 \
+  --json "$out/bench-coupling-gpu.json"
 
 # 3. the CPU kernel on this machine's cores at 256^3, the GPU's second box,
 #    for the speed-up
-step bench-fluid-cpu 60 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
+step bench-fluid-cpu 45 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
   --size 256 --precision all --forcing uniform --json "$out/bench-fluid-cpu.json"
 
 # 4. the fluid scene at the paper's box (288 x 144 x 144): a shear wave with
@@ -83,7 +92,7 @@ for precision in float double; do
            "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
  "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
 CASE
-    step "run-paper-box-$precision-$device" 45 "$bundle/bin/flocsim" run \
+    step "run-paper-box-$precision-$device" 30 "$bundle/bin/flocsim" run \
       "$out/paper-box-$precision-$device.json" --out "$out/run-paper-box-$precision-$device" --quiet
   done
 done

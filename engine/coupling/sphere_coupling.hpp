@@ -38,6 +38,46 @@ struct NamedArray {
   std::vector<double> values;
 };
 
+// The momentum and angular momentum of the liquid the lattice keeps inside
+// each sphere, as measured step by step, and their change since the previous
+// measurement: what the sphere equations add to the coupling's force and
+// torque. Every coupling (on either device) keeps one.
+class InsideMomenta {
+ public:
+  const std::vector<Vec3>& momentum() const { return momentum_; }
+  const std::vector<Vec3>& angular_momentum() const { return angular_; }
+  const std::vector<Vec3>& momentum_change() const { return momentum_change_; }
+  const std::vector<Vec3>& angular_momentum_change() const { return angular_change_; }
+
+  // Stores the momenta just measured and their change since the last ones
+  // (zero at the first step, or for a sphere count that changed).
+  void record(std::vector<Vec3> momentum, std::vector<Vec3> angular) {
+    const std::size_t n = momentum.size();
+    const bool have_previous = momentum_.size() == n;
+    momentum_change_.assign(n, Vec3::Zero());
+    angular_change_.assign(n, Vec3::Zero());
+    if (have_previous)
+      for (std::size_t s = 0; s < n; ++s) {
+        momentum_change_[s] = momentum[s] - momentum_[s];
+        angular_change_[s] = angular[s] - angular_[s];
+      }
+    momentum_ = std::move(momentum);
+    angular_ = std::move(angular);
+  }
+  // A checkpoint's momenta, so that a resumed run continues identically.
+  void restore(std::vector<Vec3> momentum, std::vector<Vec3> angular) {
+    if (momentum.size() != angular.size())
+      throw std::invalid_argument(
+          "coupling: internal momenta need one entry per sphere in both lists");
+    momentum_ = std::move(momentum);
+    angular_ = std::move(angular);
+  }
+
+ private:
+  std::vector<Vec3> momentum_, angular_;
+  std::vector<Vec3> momentum_change_, angular_change_;
+};
+
 template <class Real>
 class SphereCoupling {
  public:
@@ -63,18 +103,20 @@ class SphereCoupling {
   // This step's loads, one entry per sphere.
   const std::vector<Vec3>& force() const { return force_; }
   const std::vector<Vec3>& torque() const { return torque_; }
-  const std::vector<Vec3>& internal_momentum_change() const { return internal_momentum_change_; }
+  const std::vector<Vec3>& internal_momentum_change() const { return inside_.momentum_change(); }
   const std::vector<Vec3>& internal_angular_momentum_change() const {
-    return internal_angular_change_;
+    return inside_.angular_momentum_change();
   }
   spheres::HydrodynamicLoads loads() const {
-    return {force_, torque_, internal_momentum_change_, internal_angular_change_};
+    return {force_, torque_, inside_.momentum_change(), inside_.angular_momentum_change()};
   }
   // The inside momenta measured in this step; with the setter, a checkpoint
   // restores them so that a resumed run continues identically.
-  const std::vector<Vec3>& internal_momentum() const { return internal_momentum_; }
-  const std::vector<Vec3>& internal_angular_momentum() const { return internal_angular_; }
-  void set_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular_momentum);
+  const std::vector<Vec3>& internal_momentum() const { return inside_.momentum(); }
+  const std::vector<Vec3>& internal_angular_momentum() const { return inside_.angular_momentum(); }
+  void set_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular_momentum) {
+    inside_.restore(std::move(momentum), std::move(angular_momentum));
+  }
 
   // The scheme's own state for checkpoints (empty for schemes without one).
   virtual std::vector<NamedArray> memory() const { return {}; }
@@ -83,40 +125,15 @@ class SphereCoupling {
  protected:
   // Stores the inside momenta just measured and their change since the last
   // ones (zero at the first step, or for a sphere count that changed).
-  void record_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular);
+  void record_internal_momenta(std::vector<Vec3> momentum, std::vector<Vec3> angular) {
+    inside_.record(std::move(momentum), std::move(angular));
+  }
 
   std::vector<Vec3> force_, torque_;
 
  private:
   Scheme scheme_;
-  std::vector<Vec3> internal_momentum_, internal_angular_;
-  std::vector<Vec3> internal_momentum_change_, internal_angular_change_;
+  InsideMomenta inside_;
 };
-
-template <class Real>
-void SphereCoupling<Real>::set_internal_momenta(std::vector<Vec3> momentum,
-                                                std::vector<Vec3> angular_momentum) {
-  if (momentum.size() != angular_momentum.size())
-    throw std::invalid_argument(
-        "coupling: internal momenta need one entry per sphere in both lists");
-  internal_momentum_ = std::move(momentum);
-  internal_angular_ = std::move(angular_momentum);
-}
-
-template <class Real>
-void SphereCoupling<Real>::record_internal_momenta(std::vector<Vec3> momentum,
-                                                   std::vector<Vec3> angular) {
-  const std::size_t n = momentum.size();
-  const bool have_previous = internal_momentum_.size() == n;
-  internal_momentum_change_.assign(n, Vec3::Zero());
-  internal_angular_change_.assign(n, Vec3::Zero());
-  if (have_previous)
-    for (std::size_t s = 0; s < n; ++s) {
-      internal_momentum_change_[s] = momentum[s] - internal_momentum_[s];
-      internal_angular_change_[s] = angular[s] - internal_angular_[s];
-    }
-  internal_momentum_ = std::move(momentum);
-  internal_angular_ = std::move(angular);
-}
 
 }  // namespace flocsim::coupling

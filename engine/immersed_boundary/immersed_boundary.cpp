@@ -427,9 +427,7 @@ struct ImmersedBoundary<Real>::SphereWork {
   }
 };
 
-template <class Real>
-ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings)
-    : coupling::SphereCoupling<Real>(settings.scheme), settings_(settings) {
+void check_settings(const ImmersedBoundarySettings& settings) {
   const coupling::Scheme& scheme = settings.scheme;
   if (!scheme.immersed_boundary())
     throw std::invalid_argument("immersed boundary: the scheme is " + scheme.describe() +
@@ -451,12 +449,35 @@ ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings)
   if (!(settings.input_radius <= 10000.0))
     throw std::invalid_argument("immersed boundary: input_radius = " +
                                 std::to_string(settings.input_radius) + ": must be <= 10000 dx");
-  const int n = marker_count(settings.input_radius, scheme.marker_spacing);
+}
+
+int sphere_box_edge(double input_radius) {
+  // The box's lowest cell is floor(x - a_g) - 2, the highest stencil cell at
+  // most floor(x + a_g) + 2 <= floor(x - a_g) + ceil(2 a_g) + 3 (Roma's kernel
+  // reaches round(X) + 1, the hat floor(X) + 1).
+  return static_cast<int>(std::ceil(2.0 * input_radius)) + 5;
+}
+
+void check_box_fits(const lattice::Extent& e, double input_radius) {
+  const int length[3] = {e.nx, e.ny, e.nz};
+  for (int d = 0; d < 3; ++d)
+    if (length[d] <= 2.0 * input_radius + 3.0)
+      throw std::invalid_argument(
+          "immersed boundary: box length " + std::to_string(length[d]) +
+          " must exceed 2 a_g + 3 = " + std::to_string(2.0 * input_radius + 3.0) +
+          " (a sphere's kernel cells must not meet its own periodic image)");
+}
+
+template <class Real>
+ImmersedBoundary<Real>::ImmersedBoundary(ImmersedBoundarySettings settings)
+    : coupling::SphereCoupling<Real>(settings.scheme), settings_(settings) {
+  check_settings(settings);
+  const int n = marker_count(settings.input_radius, settings.scheme.marker_spacing);
   directions_ = fibonacci_sphere(n);
   for (const Vec3& u : directions_)
     for (int d = 0; d < 3; ++d) offsets_.push_back(settings.input_radius * u[d]);
   marker_volume_ = immersed_boundary::marker_volume(settings.input_radius, n);
-  box_ = static_cast<int>(std::ceil(2.0 * settings.input_radius)) + 5;
+  box_ = sphere_box_edge(settings.input_radius);
 }
 
 template <class Real>
@@ -587,14 +608,7 @@ void ImmersedBoundary<Real>::apply_with_kernel(lattice::ForcedLiquid<Real>& liqu
   // A stencil cell lies within W/2 of its marker in each direction.
   constexpr double half_width = 0.5 * W;
   const lattice::Extent e = liquid.extent();
-  const double ag = settings_.input_radius;
-  const int length[3] = {e.nx, e.ny, e.nz};
-  for (int d = 0; d < 3; ++d)
-    if (length[d] <= 2.0 * ag + 3.0)
-      throw std::invalid_argument(
-          "immersed boundary: box length " + std::to_string(length[d]) +
-          " must exceed 2 a_g + 3 = " + std::to_string(2.0 * ag + 3.0) +
-          " (a sphere's kernel cells must not meet its own periodic image)");
+  check_box_fits(e, settings_.input_radius);
   const lattice::ForceFieldView<Real> field = liquid.force_field();
 
   const std::size_t n = spheres.size();

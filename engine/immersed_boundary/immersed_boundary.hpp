@@ -82,6 +82,16 @@ struct ImmersedBoundarySettings {
   bool measure_slip = false;  // one more interpolation per step, for diagnostics
 };
 
+// Throws std::invalid_argument naming the setting and what is allowed where
+// `settings` cannot run (on either device).
+void check_settings(const ImmersedBoundarySettings& settings);
+// Edge of the cube of cells around a sphere that holds every marker's
+// kernel stencil and the liquid inside.
+int sphere_box_edge(double input_radius);
+// Throws unless every side of the lattice exceeds 2 a_g + 3: a sphere's
+// kernel cells must not meet its own periodic image.
+void check_box_fits(const lattice::Extent& extent, double input_radius);
+
 template <class Real>
 class ImmersedBoundary final : public coupling::SphereCoupling<Real> {
  public:

@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/lattice/kernel_body.hpp"
+
 namespace flocsim::immersed_boundary {
 
 inline double roma_kernel(double r) {
@@ -42,11 +44,13 @@ struct KernelWeights {
 // (the values of roma_kernel to round-off, one sqrt instead of three). The
 // weights sum to 1 and have zero first moment for any q, so an error in q
 // changes only the kernel's shape, never the conservation of force or torque.
-inline void roma_weights_from_root(double d, double q, double (&w)[3]) {
+// A kernel body (the GPU's coupling calls it too: marker_body.hpp).
+FLOCSIM_KERNEL_BODY void roma_weights_from_root(double d, double q, double (&w)[3]) {
   constexpr double sixth = 1.0 / 6.0;
-  w[0] = std::max(0.0, 2.0 - 3.0 * d - q) * sixth;  // max: no -1e-17 at |d| = 1/2
+  const double low = 2.0 - 3.0 * d - q, high = 2.0 + 3.0 * d - q;
+  w[0] = (low > 0.0 ? low : 0.0) * sixth;  // no -1e-17 at |d| = 1/2
   w[1] = (2.0 + 2.0 * q) * sixth;
-  w[2] = std::max(0.0, 2.0 + 3.0 * d - q) * sixth;
+  w[2] = (high > 0.0 ? high : 0.0) * sixth;
 }
 
 inline void roma_weights(double d, double (&w)[3]) {
@@ -78,7 +82,7 @@ inline double linear_kernel(double r) {
 
 // The two weights of one direction for a marker at coordinate x: cells
 // first = floor(x) and first + 1, with d = x - floor(x) in [0, 1).
-inline void linear_weights(double d, double (&w)[2]) {
+FLOCSIM_KERNEL_BODY void linear_weights(double d, double (&w)[2]) {
   w[0] = 1.0 - d;
   w[1] = d;
 }

@@ -49,6 +49,14 @@ void GpuFluidLattice<Real>::download(lattice::FluidLattice<Real>&) const {}
 template <class Real>
 void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<const Real>&) {}
 template <class Real>
+lattice::AaSlots<Real> GpuFluidLattice<Real>::device_slots() const {
+  return {};
+}
+template <class Real>
+DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
+  return {};
+}
+template <class Real>
 void GpuFluidLattice<Real>::step() {}
 template <class Real>
 void GpuFluidLattice<Real>::synchronize() const {}

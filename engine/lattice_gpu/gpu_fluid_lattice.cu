@@ -187,6 +187,25 @@ void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<con
 }
 
 template <class Real>
+lattice::AaSlots<Real> GpuFluidLattice<Real>::device_slots() const {
+  return {device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
+}
+
+template <class Real>
+DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
+  const std::size_t bytes = sizeof(Real) * static_cast<std::size_t>(extent_.cells());
+  DeviceForceField<Real> field;
+  for (int d = 0; d < 3; ++d) {
+    if (!device_->force[d]) {
+      cuda_check(cudaMalloc(&device_->force[d], bytes), "cudaMalloc of the force field");
+      cuda_check(cudaMemset(device_->force[d], 0, bytes), "cudaMemset of the force field");
+    }
+    field.component[d] = device_->force[d];
+  }
+  return field;
+}
+
+template <class Real>
 void GpuFluidLattice<Real>::step() {
   const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
   CollisionConstants<Real> k;

@@ -17,10 +17,18 @@
 #include <cstddef>
 #include <memory>
 
+#include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 
 namespace flocsim::gpu {
+
+// The per-cell force density in device memory, one array per component,
+// x fastest (the host field's layout).
+template <class Real>
+struct DeviceForceField {
+  Real* component[3] = {nullptr, nullptr, nullptr};
+};
 
 template <class Real>
 class GpuFluidLattice {
@@ -46,6 +54,14 @@ class GpuFluidLattice {
   void download(lattice::FluidLattice<Real>& host) const;
   // The per-cell force field of the next steps, from the host (x fastest).
   void upload_force_field(const lattice::ForceFieldView<const Real>& field);
+
+  // For the couplings that work on the device (engine/coupling_gpu): the
+  // populations where they are now (read with aa_load_cell and
+  // next_step_is_even()), and the force field of the next step in device
+  // memory, allocated and zeroed on first use. Neither is valid on the host.
+  lattice::AaSlots<Real> device_slots() const;
+  bool next_step_is_even() const { return time_step_ % 2 == 0; }
+  DeviceForceField<Real> device_force_field();
 
   // One lattice-Boltzmann step: collide with the current force, stream.
   void step();

@@ -1,0 +1,220 @@
+// The GPU immersed boundary (engine/coupling_gpu) against the CPU's
+// ImmersedBoundary, the reference, on the same liquid and spheres: the loads
+// of a step, the liquid after it, control forcing's carried state, a settling
+// sphere's trajectory, and a checkpoint carried from the GPU to the CPU. The
+// kernel bodies are the ones tests/immersed_boundary/marker_body_test.cpp
+// holds to the CPU coupling here; this suite checks their launch on a GPU.
+//
+// Round-off: as marker_body_test.cpp (1e-12 of the largest magnitude in
+// double, 1e-4 in float); the GPU adds atomic additions in a varying order,
+// which changes sums of ~10^3 terms by a few ulps.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "engine/coupling_gpu/gpu_immersed_boundary.hpp"
+#include "engine/immersed_boundary/immersed_boundary.hpp"
+#include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/spheres/sphere_dynamics.hpp"
+#include "tests/lattice/lattice_probes.hpp"
+
+namespace flocsim::gpu {
+namespace {
+
+using immersed_boundary::ImmersedBoundary;
+using immersed_boundary::ImmersedBoundarySettings;
+using spheres::Vec3;
+
+template <class Real>
+constexpr double kRoundOff = sizeof(Real) == 8 ? 1e-12 : 1e-4;
+
+template <class Real>
+void stir(lattice::FluidLattice<Real>& fluid) {
+  const lattice::Extent e = fluid.extent();
+  fluid.set_body_force({2e-5, -1e-5, 3e-6});
+  const double k = 2 * M_PI;
+  fluid.initialise_equilibrium([&](int x, int y, int z) {
+    lattice::Macroscopic m;
+    m.density = 1.0 + 0.01 * std::sin(k * (x + 2 * y) / e.nx);
+    m.velocity = {0.02 * std::sin(k * y / e.ny), 0.01 * std::cos(k * z / e.nz),
+                  0.015 * std::sin(k * x / e.nx)};
+    return m;
+  });
+}
+
+spheres::SphereSet three_spheres() {
+  spheres::SphereSet s;
+  s.radius = 4.0;
+  s.resize(3);
+  s.position = {Vec3(12.3, 14.6, 13.1), Vec3(20.9, 15.2, 12.4), Vec3(0.4, 24.7, 27.8)};
+  s.velocity = {Vec3(0.01, -0.005, 0.002), Vec3(-0.004, 0.003, 0.006), Vec3(0.0, 0.0, -0.008)};
+  s.angular_velocity = {Vec3(0.001, 0.0, -0.002), Vec3(0.0, 0.0015, 0.0),
+                        Vec3(-0.001, 0.001, 0.0005)};
+  return s;
+}
+
+double largest(const std::vector<Vec3>& v) {
+  double m = 0;
+  for (const Vec3& x : v) m = std::max(m, x.cwiseAbs().maxCoeff());
+  return m;
+}
+
+void expect_near_lists(const std::vector<Vec3>& gpu, const std::vector<Vec3>& cpu,
+                       double relative, const char* what) {
+  ASSERT_EQ(gpu.size(), cpu.size()) << what;
+  const double scale = largest(cpu);
+  ASSERT_GT(scale, 0) << what << " is zero: the comparison would prove nothing";
+  for (std::size_t s = 0; s < cpu.size(); ++s)
+    for (int d = 0; d < 3; ++d)
+      EXPECT_NEAR(gpu[s][d], cpu[s][d], relative * scale)
+          << what << " of sphere " << s << ", component " << d;
+}
+
+template <class Real>
+void expect_same_steps(const coupling::Scheme& scheme, int steps) {
+  const lattice::Extent e{32, 30, 28};
+  lattice::FluidLattice<Real> cpu_fluid(e, {0.02, 0.25}), mirror(e, {0.02, 0.25});
+  stir(cpu_fluid);
+  cpu_fluid.enable_force_field();
+  GpuFluidLattice<Real> gpu_fluid(e, {0.02, 0.25});
+  gpu_fluid.upload(cpu_fluid);
+  const ImmersedBoundarySettings settings{.input_radius = 3.7, .scheme = scheme};
+  ImmersedBoundary<Real> cpu(settings);
+  GpuImmersedBoundary<Real> gpu(settings);
+  const spheres::SphereSet s = three_spheres();
+  for (int step = 0; step < steps; ++step) {
+    SCOPED_TRACE("step " + std::to_string(step));
+    cpu.apply(cpu_fluid, s);
+    gpu.apply(gpu_fluid, s);
+    expect_near_lists(gpu.force(), cpu.force(), kRoundOff<Real>, "force");
+    expect_near_lists(gpu.torque(), cpu.torque(), kRoundOff<Real>, "torque");
+    expect_near_lists(gpu.inside().momentum(), cpu.internal_momentum(), kRoundOff<Real>,
+                      "inside momentum");
+    expect_near_lists(gpu.inside().angular_momentum(), cpu.internal_angular_momentum(),
+                      kRoundOff<Real>, "inside angular momentum");
+    cpu_fluid.step();
+    gpu_fluid.step();
+  }
+  // the liquid after the steps: the forces went into it alike
+  gpu_fluid.download(mirror);
+  const auto a = testing::slots_of(cpu_fluid), b = testing::slots_of(mirror);
+  double worst = 0, scale = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    worst = std::max(worst, std::abs(static_cast<double>(a[k]) - b[k]));
+    scale = std::max(scale, std::abs(static_cast<double>(a[k])));
+  }
+  EXPECT_LE(worst, kRoundOff<Real> * scale) << "populations after " << steps << " steps";
+  if (scheme.control()) {
+    const auto m_gpu = gpu.memory(), m_cpu = cpu.memory();
+    ASSERT_EQ(m_gpu.size(), m_cpu.size());
+    for (std::size_t q = 0; q < m_cpu.size(); ++q) {
+      ASSERT_EQ(m_gpu[q].name, m_cpu[q].name);
+      ASSERT_EQ(m_gpu[q].values.size(), m_cpu[q].values.size());
+      double big = 0;
+      for (double v : m_cpu[q].values) big = std::max(big, std::abs(v));
+      for (std::size_t k = 0; k < m_cpu[q].values.size(); ++k)
+        EXPECT_NEAR(m_gpu[q].values[k], m_cpu[q].values[k], kRoundOff<Real> * big)
+            << m_cpu[q].name << " number " << k;
+    }
+  }
+}
+
+coupling::Scheme direct(int sweeps, coupling::Kernel kernel) {
+  coupling::Scheme s;
+  s.sweeps = sweeps;
+  s.kernel = kernel;
+  return s;
+}
+
+coupling::Scheme control() {
+  coupling::Scheme s;
+  s.forcing = coupling::Forcing::control;
+  s.sweeps = 1;
+  s.gains = {1.5, 0.5};
+  return s;
+}
+
+TEST(GpuCoupling, DirectForcingStepsMatchTheCpuCoupling) {
+  expect_same_steps<double>(direct(1, coupling::Kernel::roma3), 3);
+  expect_same_steps<double>(direct(2, coupling::Kernel::linear2), 3);
+  expect_same_steps<float>(direct(2, coupling::Kernel::roma3), 3);
+}
+
+TEST(GpuCoupling, ControlForcingStepsAndCarriedStateMatchTheCpuCoupling) {
+  expect_same_steps<double>(control(), 4);
+  expect_same_steps<float>(control(), 4);
+}
+
+// A settling sphere, 400 steps of the coupled loop with the sphere equations
+// on the CPU (as a run does), on both devices: the GPU's trajectory follows
+// the CPU's to round-off grown over the steps (double), and the sphere does
+// settle (its speed along gravity grows to a sizeable fraction of a terminal
+// velocity), so that the comparison is not between two spheres at rest.
+TEST(GpuCoupling, SettlingSphereFollowsTheCpuTrajectory) {
+  const lattice::Extent e{48, 40, 40};
+  const double a = 4.0, ag = 3.7;
+  lattice::FluidLattice<double> cpu_fluid(e, {0.05, 0.25});
+  cpu_fluid.enable_force_field();
+  GpuFluidLattice<double> gpu_fluid(e, {0.05, 0.25});
+  spheres::SphereDynamicsSettings dynamics;
+  dynamics.external = spheres::settling_forces(1, a, 4.0, static_cast<double>(e.cells()), 2e-6);
+  cpu_fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
+  gpu_fluid.upload(cpu_fluid);
+  const ImmersedBoundarySettings settings{.input_radius = ag, .scheme = direct(2, coupling::Kernel::roma3)};
+  ImmersedBoundary<double> cpu(settings);
+  GpuImmersedBoundary<double> gpu(settings);
+  spheres::SphereSet s_cpu;
+  s_cpu.radius = a;
+  s_cpu.resize(1);
+  s_cpu.position[0] = Vec3(20.3, 19.6, 20.1);
+  spheres::SphereSet s_gpu = s_cpu;
+  const spheres::PeriodicBox box{Vec3(e.nx, e.ny, e.nz)};
+  for (int step = 0; step < 400; ++step) {
+    cpu.apply(cpu_fluid, s_cpu);
+    cpu_fluid.step();
+    spheres::advance_velocities(s_cpu, cpu.loads(), dynamics);
+    spheres::advance_positions(s_cpu, box);
+    gpu.apply(gpu_fluid, s_gpu);
+    gpu_fluid.step();
+    spheres::advance_velocities(s_gpu, gpu.loads(), dynamics);
+    spheres::advance_positions(s_gpu, box);
+  }
+  const double u = s_cpu.velocity[0].x();
+  ASSERT_LT(u, -1e-4) << "the sphere did not settle: the comparison would prove little";
+  EXPECT_NEAR(s_gpu.velocity[0].x(), u, 1e-9 * std::abs(u));
+  EXPECT_LE((s_gpu.position[0] - s_cpu.position[0]).norm(), 1e-9 * a);
+}
+
+// A checkpoint of a GPU run with control forcing (its carried marker state
+// and inside momenta) resumes on the CPU: the CPU coupling restored from it
+// gives the step the GPU coupling gives.
+TEST(GpuCoupling, ControlForcingStateMovesFromTheGpuToTheCpu) {
+  const lattice::Extent e{32, 30, 28};
+  lattice::FluidLattice<double> host(e, {0.02, 0.25});
+  stir(host);
+  host.enable_force_field();
+  GpuFluidLattice<double> gpu_fluid(e, {0.02, 0.25});
+  gpu_fluid.upload(host);
+  const ImmersedBoundarySettings settings{.input_radius = 3.7, .scheme = control()};
+  GpuImmersedBoundary<double> gpu(settings);
+  const spheres::SphereSet s = three_spheres();
+  for (int step = 0; step < 3; ++step) {
+    gpu.apply(gpu_fluid, s);
+    gpu_fluid.step();
+  }
+  gpu_fluid.download(host);  // the checkpoint: populations, marker state, inside momenta
+  ImmersedBoundary<double> cpu(settings);
+  cpu.restore_memory(gpu.memory());
+  cpu.set_internal_momenta(gpu.inside().momentum(), gpu.inside().angular_momentum());
+  gpu.apply(gpu_fluid, s);
+  cpu.apply(host, s);
+  expect_near_lists(gpu.force(), cpu.force(), 1e-12, "force after the move");
+  expect_near_lists(gpu.inside().momentum_change(), cpu.internal_momentum_change(), 1e-10,
+                    "inside momentum change after the move");
+}
+
+}  // namespace
+}  // namespace flocsim::gpu
