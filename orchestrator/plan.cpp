@@ -138,6 +138,7 @@ double schedule(const std::vector<double>& durations, int lanes) {
 }  // namespace
 
 std::optional<double> StepCost::step_s() const {
+  if (gpu_step_s) return gpu_step_s;
   if (db_runs > 0) return db_step_s;
   if (measured_together && measured_together->steps > 0) return measured_together->step_s;
   if (measured && measured->steps > 0) return measured->step_s;
@@ -145,11 +146,15 @@ std::optional<double> StepCost::step_s() const {
 }
 
 int StepCost::threads() const {
+  if (gpu_step_s) return 1;  // one GPU, its worker's one host thread
   if (db_runs > 0 && db_threads > 0) return db_threads;
   return measured ? measured->threads : 0;
 }
 
 std::string StepCost::basis() const {
+  if (gpu_step_s)
+    return "on the GPU " + gpu_name + ": " + step_time_text(*gpu_step_s) +
+           " per step from its benchmark figures (--gpu-rate; setup not included)";
   std::string out;
   if (measured && measured->steps > 0)
     out = "measured here: " + step_time_text(measured->step_s) + " per step alone (" +
@@ -164,6 +169,7 @@ std::string StepCost::basis() const {
            (db_runs == 1 ? "" : "s") + " in the database: " + step_time_text(db_step_s) +
            " per step (median, wall time over steps" +
            (db_threads > 0 ? ", " + std::to_string(db_threads) + " threads" : "") + ")";
+  if (!gpu_why.empty()) out += (out.empty() ? "" : "; ") + ("not on the GPU: " + gpu_why);
   return out.empty() ? "no rate: not measured (--measure-steps 0) and no completed run of it "
                        "in a database"
                      : out;
@@ -237,6 +243,10 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
         it = cost_of_key.emplace(key, static_cast<int>(plan.costs.size()) - 1).first;
       }
       r.cost = it->second;
+      if (o.gpu) {
+        std::string why;
+        r.gpu_step_s = o.gpu->step_s(parsed, r.size, why);
+      }
       if (!r.complete) {
         ++plan.costs[r.cost].runs;
         ++plan.to_run;
@@ -254,6 +264,11 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
   for (std::size_t i = 0; i < plan.costs.size(); ++i) {
     StepCost& c = plan.costs[i];
     if (c.runs == 0) continue;
+    if (o.gpu) {
+      c.gpu_name = o.gpu->gpu;
+      c.gpu_step_s = o.gpu->step_s(first_case[i], run::case_size(first_case[i]), c.gpu_why);
+      if (c.gpu_step_s) continue;  // nothing to measure here
+    }
     if (o.db) from_database(*o.db, c);
     if (o.measure_steps > 0) {
       if (o.progress)
@@ -292,7 +307,7 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
   for (PlannedRun& r : plan.runs) {
     if (r.cost < 0 || r.complete || !r.refused.empty()) continue;
     const StepCost& c = plan.costs[r.cost];
-    const auto step_s = c.step_s();
+    const auto step_s = r.gpu_step_s ? r.gpu_step_s : c.step_s();
     if (!step_s) {
       every_rate = false;
       continue;
@@ -301,20 +316,25 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
     // A rate measured with the workers running at once holds their sharing of
     // the cores; any other, where they outnumber the cores, is scaled by it.
     const bool shared_in_rate = c.db_runs == 0 && c.measured_together;
-    const double slowdown = o.backend == "local" && !shared_in_rate
+    const double slowdown = o.backend == "local" && !shared_in_rate && !c.gpu_step_s
                                 ? std::max(1.0, static_cast<double>(lanes) * threads / plan.cores)
                                 : 1.0;
     plan.slowdown = std::max(plan.slowdown, slowdown);
     // a database's wall time per step already holds the setup and output
-    const double setup = c.db_runs > 0 ? 0.0 : c.measured->setup_s;
+    const double setup = c.db_runs > 0 || c.gpu_step_s ? 0.0 : c.measured->setup_s;
     const double alone_min = setup + *step_s * static_cast<double>(r.size.steps_min);
     const double alone_max = setup + *step_s * static_cast<double>(r.size.steps_max);
     r.wall_min_s = alone_min * slowdown;
     r.wall_max_s = alone_max * slowdown;
     fastest.push_back(*r.wall_min_s);
     slowest.push_back(*r.wall_max_s);
-    core_s_min += alone_min * threads;
-    core_s_max += alone_max * threads;
+    if (c.gpu_step_s) {
+      plan.gpu_hours_min += alone_min / 3600;
+      plan.gpu_hours_max += alone_max / 3600;
+    } else {
+      core_s_min += alone_min * threads;
+      core_s_max += alone_max * threads;
+    }
   }
   if (every_rate && plan.to_run > 0) {
     plan.core_hours_min = core_s_min / 3600;
@@ -350,6 +370,13 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
             "raise the limit or lower runs_per_task");
     }
   }
+  if (o.gpu && std::any_of(plan.runs.begin(), plan.runs.end(), [](const PlannedRun& r) {
+        return r.gpu_step_s && r.size.spheres > 0;
+      }))
+    plan.notes.push_back(
+        "sphere scenes do not run on the GPU yet (docs/gpu.md): their GPU figures project the "
+        "benchmark's coupled step (the immersed boundary and the lattice on the GPU, the sphere "
+        "side on the CPU) onto each configuration");
   const double memory = cases::physical_memory_bytes();
   if (o.backend == "local" && memory > 0 && lanes * plan.memory_per_run_max > 0.8 * memory)
     plan.notes.push_back(std::to_string(lanes) + " runs at once need about " +
@@ -442,14 +469,19 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
     out << "total: "
         << range_text(number_text(p.lattice_updates_min), number_text(p.lattice_updates_max))
         << " lattice updates";
-    if (p.core_hours_min)
+    if (p.core_hours_min && (*p.core_hours_max > 0 || p.gpu_hours_max == 0))
       out << ", " << range_text(hours_text(*p.core_hours_min), hours_text(*p.core_hours_max))
           << " core-hours (wall time x threads)";
+    if (p.gpu_hours_max > 0)
+      out << ", " << range_text(hours_text(p.gpu_hours_min), hours_text(p.gpu_hours_max))
+          << " GPU-hours";
     out << "\n";
     if (p.wall_min_s) {
       out << "estimated wall time: "
           << range_text(duration_text(*p.wall_min_s), duration_text(*p.wall_max_s));
-      if (p.backend == "local") {
+      if (p.gpu_hours_max > 0) {
+        out << " at --jobs " << p.jobs << ", each worker on a GPU as fast as the benchmark's\n";
+      } else if (p.backend == "local") {
         out << " at --jobs " << p.jobs << " on this machine (" << p.cores << " cores";
         if (p.slowdown > 1) {
           char buf[96];

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "engine/run/case_cost.hpp"
+#include "orchestrator/gpu_rates.hpp"
 #include "orchestrator/sweep.hpp"
 
 namespace flocsim::db {
@@ -28,6 +29,9 @@ struct PlanOptions {
   int measure_steps = 3;             // steps timed per configuration at least; 0: none
   double measure_seconds = 1.0;      // ... and at least this long
   db::ResultsDb* db = nullptr;       // completed runs give the rate; complete runs are skipped
+  // A GPU's benchmark figures (--gpu-rate): every configuration the GPU can
+  // run is estimated on it, one GPU per worker, instead of measured here.
+  const GpuRates* gpu = nullptr;
   std::ostream* progress = nullptr;  // "measuring ..." lines while it works
 };
 
@@ -43,8 +47,11 @@ struct StepCost {
   int db_runs = 0;       // completed runs of this configuration in the database
   double db_step_s = 0;  // their median wall seconds per step (setup and output included)
   int db_threads = 0;
-  // seconds per step and threads of the estimate: the database's when it has
-  // runs, else the measurement's; empty when neither exists
+  std::optional<double> gpu_step_s;  // from --gpu-rate, where it has a figure
+  std::string gpu_name, gpu_why;     // the GPU; why it has no figure
+  // seconds per step and threads of the estimate: the GPU's with --gpu-rate,
+  // else the database's when it has runs, else the measurement's; empty when
+  // none exists
   std::optional<double> step_s() const;
   int threads() const;
   std::string basis() const;  // where the figure comes from, in words
@@ -56,6 +63,9 @@ struct PlannedRun {
   bool complete = false;  // already completed in the database: nothing to do
   run::CaseSize size;
   int cost = -1;  // index into SweepPlan::costs
+  // --gpu-rate: this run's seconds per step on the GPU (its own marker count:
+  // the input radius, which a configuration leaves out, sets it)
+  std::optional<double> gpu_step_s;
   // estimated wall seconds of the run, shortest and longest protocol, on
   // this machine at the planned concurrency; empty without a rate
   std::optional<double> wall_min_s, wall_max_s;
@@ -71,7 +81,8 @@ struct SweepPlan {
   int to_run = 0, refused = 0, complete = 0;
   double lattice_updates_min = 0, lattice_updates_max = 0;  // of the runs to run
   std::optional<double> wall_min_s, wall_max_s;             // the whole sweep
-  std::optional<double> core_hours_min, core_hours_max;
+  std::optional<double> core_hours_min, core_hours_max;  // of the runs on CPU cores
+  double gpu_hours_min = 0, gpu_hours_max = 0;          // of the runs estimated on a GPU
   double memory_per_run_max = 0;   // bytes, the largest configuration measured
   std::vector<std::string> notes;  // warnings: memory, Slurm time limits
 };

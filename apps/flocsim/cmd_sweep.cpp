@@ -11,6 +11,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "apps/flocsim/command_registry.hpp"
@@ -43,6 +44,7 @@ struct SweepOptions {
   int measure_steps = 3;
   double watch_s = 0;
   std::string plan_db;
+  std::vector<std::string> gpu_rate_files;  // plan --gpu-rate
   // slurm-task (internal)
   std::string task_file;
 };
@@ -258,6 +260,11 @@ const bool registered = register_command(
        plan->add_option("--measure-steps", o->measure_steps,
                         "Time steps of each configuration measured here (0: none)")
            ->check(CLI::Range(0, 1000));
+       plan->add_option("--gpu-rate", o->gpu_rate_files,
+                        "Estimate on a GPU: the JSON files bench_fluid_gpu and bench_coupling_gpu "
+                        "wrote there (scripts/device-check.sh writes both); configurations the "
+                        "GPU cannot run are measured here as usual")
+           ->expected(1, 2);
        plan->callback([action] { *action = "plan"; });
 
        CLI::App* launch = cmd.add_subcommand(
@@ -310,11 +317,14 @@ const bool registered = register_command(
              std::unique_ptr<db::ResultsDb> db;
              if (!o->plan_db.empty())
                db = std::make_unique<db::ResultsDb>(o->plan_db, db::ResultsDb::Mode::kReadOnly);
+             std::optional<orc::GpuRates> gpu;
+             if (!o->gpu_rate_files.empty()) gpu = orc::read_gpu_rates(o->gpu_rate_files);
              orc::PlanOptions p;
              p.jobs = o->jobs;
              p.backend = o->backend;
              p.measure_steps = o->measure_steps;
              p.db = db.get();
+             p.gpu = gpu ? &*gpu : nullptr;
              p.progress = &std::cerr;
              orc::write_plan(orc::plan_sweep(spec, p), std::cout, true);
              return kExitOk;

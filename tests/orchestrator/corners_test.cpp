@@ -51,7 +51,7 @@ TEST(GridCorners, EachPresetRefusesExactlyTheCornersItCannotRun) {
   for (const std::string preset : {"draft", "standard", "paper"}) {
     const std::string suffix = preset == "draft" ? "" : "-" + preset;
     std::set<Corner> seen, refused;
-    for (const std::string file :
+    for (const std::string& file :
          {"corners" + suffix + ".json", "corners-extra" + suffix + ".json"}) {
       const orc::SweepPlan plan = plan_of(file);
       for (const orc::PlannedRun& r : plan.runs) {

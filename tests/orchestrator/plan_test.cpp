@@ -7,9 +7,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "engine/case/case_file.hpp"
+#include "engine/immersed_boundary/sphere_markers.hpp"
 #include "engine/input/input_reader.hpp"
 #include "orchestrator/sweep.hpp"
 
@@ -139,6 +142,97 @@ TEST(SweepPlan, TimesTheRealStepAndWeighsTheLatticesStorage) {
   for (const orc::PlannedRun& r : plan.runs) sum += *r.wall_max_s;
   ASSERT_TRUE(plan.wall_max_s);
   EXPECT_NEAR(*plan.wall_max_s, sum, 1e-9 * sum);
+}
+
+// --gpu-rate: a GPU benchmark's figures (as bench_coupling_gpu and
+// bench_fluid_gpu write them) give each configuration's seconds per step by
+// the model of orchestrator/gpu_rates.hpp, worked here by hand: the paper's
+// case at the paper preset (288 x 144 x 144, N = 1320) on a GPU whose fluid
+// runs at 8000 MLUPS beside the coupling and whose immersed boundary takes
+// 1.5 ms for 1320 x 900 markers.
+TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
+  const std::string dir = ::testing::TempDir() + "/plan-gpu-rate";
+  std::filesystem::create_directories(dir);
+  const orc::SweepSpec spec = paper_grid("paper");
+  const auto first = flocsim::cases::parse_case(orc::expand(spec).front().case_json);
+  const flocsim::coupling::Scheme& scheme = first.spheres.numerics.coupling;
+  const bool single = first.spheres.numerics.single_precision;
+  nlohmann::json bench = {
+      {"gpu", "NVIDIA H100 (test figures)"},
+      {"results",
+       {{{"option", scheme.describe()},
+         {"precision", single ? "float" : "double"},
+         {"fluid_MLUPS", 8000.0},
+         {"immersed_boundary_ms", 1.5},
+         {"spheres", 1320},
+         {"markers_per_sphere", 900}}}}};
+  const std::string file = dir + "/bench-coupling-gpu.json";
+  std::ofstream(file) << bench.dump(2);
+  const orc::GpuRates rates = orc::read_gpu_rates({file});
+  orc::PlanOptions o;
+  o.measure_steps = 0;
+  o.gpu = &rates;
+  const orc::SweepPlan plan = orc::plan_sweep(spec, o);
+  double gpu_hours = 0;
+  int checked = 0;
+  for (const orc::PlannedRun& r : plan.runs) {
+    if (!r.refused.empty()) continue;
+    const auto parsed = flocsim::cases::parse_case(r.point.case_json);
+    const double markers =
+        r.size.spheres * flocsim::immersed_boundary::marker_count(
+                             parsed.spheres.numerics.input_radius, scheme.marker_spacing);
+    const double step = r.size.cells / 8000e6 + 1.5e-3 * markers / (1320.0 * 900.0);
+    ASSERT_TRUE(r.wall_min_s) << r.point.case_json.dump();
+    EXPECT_NEAR(*r.wall_min_s, step * r.size.steps_min, 1e-9 * *r.wall_min_s);
+    EXPECT_NEAR(*r.wall_max_s, step * r.size.steps_max, 1e-9 * *r.wall_max_s);
+    gpu_hours += step * r.size.steps_max / 3600;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 120);
+  EXPECT_NEAR(plan.gpu_hours_max, gpu_hours, 1e-9 * gpu_hours);
+  std::ostringstream text;
+  orc::write_plan(plan, text, false);
+  EXPECT_THAT(text.str(), HasSubstr("on the GPU NVIDIA H100 (test figures)"));
+  EXPECT_THAT(text.str(), HasSubstr("GPU-hours"));
+
+  // A figure of another precision is no figure for this grid: the plan says
+  // why and falls back to what it has here (no measurement: no rate).
+  bench["results"][0]["precision"] = single ? "double" : "float";
+  std::ofstream(file) << bench.dump(2);
+  const orc::GpuRates other = orc::read_gpu_rates({file});
+  o.gpu = &other;
+  const orc::SweepPlan without = orc::plan_sweep(spec, o);
+  EXPECT_FALSE(without.wall_min_s);
+  std::ostringstream why;
+  orc::write_plan(without, why, false);
+  EXPECT_THAT(why.str(), HasSubstr("not on the GPU: no coupled-step benchmark of " +
+                                   scheme.describe()));
+}
+
+TEST(SweepPlan, RefusesAGpuRateFileThatIsNotABenchmarksOutput) {
+  const std::string dir = ::testing::TempDir() + "/plan-gpu-rate-bad";
+  std::filesystem::create_directories(dir);
+  auto refusal = [&](const std::string& text) {
+    const std::string file = dir + "/rate.json";
+    std::ofstream(file) << text;
+    try {
+      orc::read_gpu_rates({file});
+    } catch (const flocsim::input::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_THAT(refusal(R"({"results": []})"), HasSubstr("not a GPU benchmark's output"));
+  EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "float", "MLUPS": -3}]})"),
+              HasSubstr("results[0].MLUPS = -3: must be a positive finite number"));
+  EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "half", "MLUPS": 3}]})"),
+              HasSubstr("results[0].precision: must be \"float\" or \"double\""));
+  EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "float", "option": "x",
+                         "fluid_MLUPS": 1, "immersed_boundary_ms": 1, "spheres": 0,
+                         "markers_per_sphere": 9}]})"),
+              HasSubstr("results[0].spheres = 0: must be a positive finite number"));
+  EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "float"}]})"),
+              HasSubstr("neither a fluid result"));
 }
 
 TEST(SweepPlan, ReadsSlurmTimeLimitsInEveryForm) {
