@@ -40,7 +40,9 @@ int run_command(const RunArguments& a) {
     return kExitBadInput;
   }
   // A GPU that is not there is found out now, before any output is written.
-  if (parsed.fluid_scene && parsed.fluid.device == cases::Device::cuda) {
+  const bool on_gpu = parsed.fluid_scene ? parsed.fluid.device == cases::Device::cuda
+                                         : parsed.spheres.device == cases::Device::cuda;
+  if (on_gpu) {
     const gpu::GpuQuery q = gpu::query_gpus();
     if (q.devices.empty()) {
       std::fprintf(stderr,
@@ -52,13 +54,18 @@ int run_command(const RunArguments& a) {
     // the populations must fit the GPU's free memory (the host mirror is
     // checked with the case, against this machine's); the lattice takes its
     // memory before any output too, should another process take it meanwhile
-    const double bytes = 19.0 * static_cast<double>(parsed.fluid.size.cells()) *
-                         (parsed.fluid.precision == cases::Precision::single_precision ? 4 : 8);
+    // (a sphere scene adds the 3-component force field the immersed boundary writes)
+    const double cells = static_cast<double>(parsed.fluid_scene ? parsed.fluid.size.cells()
+                                                                : parsed.spheres.derived.box.cells());
+    const bool single = parsed.fluid_scene
+                            ? parsed.fluid.precision == cases::Precision::single_precision
+                            : parsed.spheres.numerics.single_precision;
+    const double bytes = (parsed.fluid_scene ? 19.0 : 22.0) * cells * (single ? 4 : 8);
     const double available = 0.9 * q.devices.front().free_gib * (1u << 30);
     if (bytes > available) {
       std::fprintf(stderr,
-                   "flocsim run: input error in %s: fluid.size: the populations take %.1f GiB, "
-                   "more than 90 %% of the %.1f GiB free on the GPU (%s); use a smaller box, float "
+                   "flocsim run: input error in %s: the lattice takes %.1f GiB on the GPU, "
+                   "more than 90 %% of the %.1f GiB free there (%s); use a smaller box, float "
                    "precision, or --device cpu\n",
                    a.case_file.c_str(), bytes / (1u << 30), q.devices.front().free_gib,
                    q.devices.front().name.c_str());

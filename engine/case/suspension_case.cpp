@@ -292,14 +292,14 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
   const Preset p = preset(c.fidelity);
   c.numerics.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
-  // The coupled step (immersed boundary, partially saturated cells, sphere
-  // averages) has no CUDA back-end yet: only the fluid scene's lattice runs
-  // on a GPU (docs/gpu.md says what moves next).
-  if (root.choice("device", {"cpu", "cuda"}, "cpu") == "cuda")
+  // On a GPU the lattice and the immersed boundary run there (docs/gpu.md);
+  // which scenes and couplings can is checked once the coupling is known.
+  parse_device_name(root.choice("device", {"cpu", "cuda"}, "cpu"), c.device);
+  if (c.device == Device::cuda && !modules_of(c.scene).liquid)
     throw InputError(root.field("device") + " = \"cuda\": scene \"" +
                      std::string(scene_name(c.scene)) +
-                     "\" runs on the CPU only (its coupled step has no CUDA back-end yet; the "
-                     "fluid scene's lattice runs on a GPU); give \"cpu\" or leave the field out");
+                     "\" has no liquid, and the GPU runs the lattice; give \"cpu\" or leave the "
+                     "field out");
   c.seed =
       static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
 
@@ -470,6 +470,10 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       }
     }
   }
+  if (c.device == Device::cuda && !c.numerics.coupling.immersed_boundary())
+    throw InputError("device = \"cuda\" with numerics.coupling = \"partially-saturated\": "
+                     "partially saturated cells do not run on the GPU yet (docs/gpu.md); give "
+                     "numerics.coupling = \"immersed-boundary\" or device \"cpu\"");
   // numerics.immersed_boundary as the case file writes it, for messages that
   // show the scheme: a field it leaves out is marked as the default
   const nlohmann::json ib_given =
@@ -746,6 +750,7 @@ nlohmann::json SuspensionCase::to_json() const {
   j["scene"] = std::string(scene_name(scene));
   j["fidelity"] = fidelity;
   j["precision"] = numerics.single_precision ? "float" : "double";
+  if (device != Device::cpu) j["device"] = device_name(device);
   j["seed"] = seed;
   if (!positions_from.empty())
     j["positions_from"] = positions_from;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/case/device.hpp"
 #include "engine/case/scene.hpp"
 #include "engine/coupling/scheme.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
@@ -137,6 +138,7 @@ struct Derived {
 
 struct SuspensionCase {
   Scene scene = Scene::suspension;
+  Device device = Device::cpu;  // "device": where the lattice and its coupling step (device.hpp)
   std::string fidelity = "standard";
   std::uint64_t seed = 1;
 

@@ -49,6 +49,8 @@ void GpuFluidLattice<Real>::download(lattice::FluidLattice<Real>&) const {}
 template <class Real>
 void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<const Real>&) {}
 template <class Real>
+void GpuFluidLattice<Real>::download_force_field(lattice::FluidLattice<Real>&) const {}
+template <class Real>
 lattice::AaSlots<Real> GpuFluidLattice<Real>::device_slots() const {
   return {};
 }

@@ -1,6 +1,7 @@
 // The GPU lattice's launchers: one thread per cell, a block per run of cells
 // along x (coalesced loads and stores in each direction's slot array), the
 // cell's work the shared kernel body aa_update_cell (engine/lattice/aa_cell.hpp).
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -183,6 +184,24 @@ void GpuFluidLattice<Real>::upload_force_field(const lattice::ForceFieldView<con
       cuda_check(cudaMalloc(&device_->force[d], bytes), "cudaMalloc of the force field");
     cuda_check(cudaMemcpy(device_->force[d], field.component[d], bytes, cudaMemcpyHostToDevice),
                "upload of the force field");
+  }
+}
+
+template <class Real>
+void GpuFluidLattice<Real>::download_force_field(lattice::FluidLattice<Real>& host) const {
+  const lattice::Extent& e = host.extent();
+  if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
+    throw std::invalid_argument("GPU lattice: force field into a lattice of another extent");
+  const lattice::ForceFieldView<Real> field = host.force_field();
+  const std::size_t count = static_cast<std::size_t>(extent_.cells());
+  for (int d = 0; d < 3; ++d) {
+    if (!device_->force[d]) {
+      std::fill_n(field.component[d], count, Real(0));
+      continue;
+    }
+    cuda_check(cudaMemcpy(field.component[d], device_->force[d], sizeof(Real) * count,
+                          cudaMemcpyDeviceToHost),
+               "download of the force field");
   }
 }
 

@@ -28,9 +28,11 @@
 
 #include "engine/case/suspension_case.hpp"
 #include "engine/coupling/sphere_coupling.hpp"
+#include "engine/coupling_gpu/gpu_sphere_coupling.hpp"
 #include "engine/coupling_schemes/make_coupling.hpp"
 #include "engine/events/direct_interactions.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
 #include "engine/lubrication/radial_lubrication.hpp"
 #include "engine/run/coupling_monitor.hpp"
 #include "engine/run/timed_stages.hpp"
@@ -46,17 +48,24 @@ inline constexpr std::string_view lubrication = "lubrication";
 inline constexpr std::string_view events = "events";
 }  // namespace stage_name
 
-// The liquid and its coupling to the spheres (scenes with a liquid).
+// The liquid and its coupling to the spheres (scenes with a liquid). On a
+// GPU (`device` given: the case's "device": "cuda") the lattice steps there
+// and the immersed boundary couples the spheres to it (engine/coupling_gpu);
+// `fluid` is then the run's mirror, brought up to date by to_host() before
+// anything reads it (the observables, checkpoints, the final fields), so that
+// everything downstream is the CPU run's code unchanged.
 template <class Real>
 struct Liquid {
   lattice::FluidLattice<Real> fluid;
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
   std::unique_ptr<coupling::SphereCoupling<Real>> coupling;
   spheres::SphereDynamicsSettings dynamics;
   std::vector<std::uint8_t> solid;  // scratch of the liquid averages
 
-  explicit Liquid(const cases::SuspensionCase& c)
+  explicit Liquid(const cases::SuspensionCase& c,
+                  std::unique_ptr<gpu::GpuFluidLattice<Real>> on_gpu = nullptr)
       : fluid(c.derived.box, {c.numerics.viscosity, c.numerics.trt_magic}),
-        coupling(coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius)) {
+        device(std::move(on_gpu)) {
     const double volume = static_cast<double>(c.derived.box.cells());
     dynamics.external = spheres::settling_forces(static_cast<std::size_t>(c.derived.sphere_count),
                                                  c.numerics.radius_cells, c.physics.density_ratio,
@@ -64,6 +73,38 @@ struct Liquid {
     dynamics.rigid_inside_liquid = c.numerics.inside_liquid == "rigid-body";
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
     if (c.numerics.coupling.immersed_boundary()) fluid.enable_force_field();
+    if (device) {
+      // the case parser lets only the immersed boundary onto a GPU
+      device->set_body_force(fluid.body_force());
+      coupling = std::make_unique<gpu::GpuSphereCoupling<Real>>(
+          immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius,
+                                                      c.numerics.coupling, false},
+          *device);
+    } else {
+      coupling = coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius);
+    }
+  }
+
+  // One collision and streaming step, where the lattice lives. On the GPU it
+  // is waited for, so that the fluid's stage time is the fluid's (the
+  // coupling's next apply() would wait for it anyway).
+  void step() {
+    if (device) {
+      device->step();
+      device->synchronize();
+    } else {
+      fluid.step();
+    }
+  }
+  // The mirror up to date with the GPU: populations and the force field.
+  void to_host() {
+    if (!device) return;
+    device->download(fluid);
+    device->download_force_field(fluid);
+  }
+  // The mirror's state (placed or resumed) onto the GPU.
+  void to_device() {
+    if (device) device->upload(fluid);
   }
 };
 
@@ -86,7 +127,9 @@ template <class Real>
 class CoupledStep {
  public:
   // `escape_velocity`: the square well's strength at the start (the protocol's).
-  CoupledStep(const cases::SuspensionCase& c, double escape_velocity, TimedStages& stages)
+  // `device`: the lattice on a GPU for a case on "cuda" (null: the CPU).
+  CoupledStep(const cases::SuspensionCase& c, double escape_velocity, TimedStages& stages,
+              std::unique_ptr<gpu::GpuFluidLattice<Real>> device = nullptr)
       : modules_(cases::modules_of(c.scene)),
         box_{spheres::Vec3(c.derived.box.nx, c.derived.box.ny, c.derived.box.nz)},
         contacts_({.restitution = c.physics.restitution,
@@ -103,7 +146,7 @@ class CoupledStep {
     // The stages a scene reports: those of the liquid's coupling wherever
     // there is a liquid, events always (0 s without contacts).
     if (modules_.liquid) {
-      liquid_ = std::make_unique<Liquid<Real>>(c);
+      liquid_ = std::make_unique<Liquid<Real>>(c, std::move(device));
       if (modules_.spheres_move) coupling_ = std::make_unique<CouplingMonitor>();
       coupling_stage_ = stages.declare(liquid_->coupling->stage_name());
       fluid_stage_ = stages.declare(stage_name::fluid);
@@ -123,7 +166,7 @@ class CoupledStep {
       Liquid<Real>& l = *liquid_;
       coupling::SphereCoupling<Real>& coupling = *l.coupling;
       stages_.run(coupling_stage_, [&] { coupling.apply(l.fluid, s); });
-      stages_.run(fluid_stage_, [&] { l.fluid.step(); });
+      stages_.run(fluid_stage_, [&] { l.step(); });
       stages_.run(coupling_stage_, [&] { coupling.after_liquid_step(l.fluid, s); });
       stages_.run(spheres_stage_, [&] {
         if (modules_.spheres_move) spheres::advance_velocities(s, coupling.loads(), l.dynamics);

@@ -172,6 +172,28 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
 
 template <class Real>
 RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
+  // On a GPU the lattice and the immersed boundary step there (Liquid in
+  // coupled_step.hpp); its memory is taken before the output folder is
+  // touched, so a GPU that cannot hold the lattice refuses the run up front.
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
+  if (c.device == cases::Device::cuda) {
+    try {
+      device = std::make_unique<gpu::GpuFluidLattice<Real>>(
+          c.derived.box, lattice::Relaxation{c.numerics.viscosity, c.numerics.trt_magic});
+    } catch (const std::exception& e) {
+      throw input::InputError(std::string("device = \"cuda\": ") + e.what() +
+                              "; run on the CPU with --device cpu");
+    }
+  }
+  nlohmann::json device_record;
+  if (device) {
+    const gpu::GpuDevice& g = device->gpu();
+    device_record = {{"kind", "cuda"},
+                     {"name", g.name},
+                     {"memory_gib", g.memory_gib},
+                     {"compute_capability",
+                      std::to_string(g.compute_major) + "." + std::to_string(g.compute_minor)}};
+  }
   RunShell shell(o, c.to_json(), c.warnings, c.protocol.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
   RunLog& log = shell.log();
@@ -180,7 +202,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   // ---- the modules of the scene, the protocol around them ---------------------
   TimedStages stages;
   Protocol protocol(c, modules);
-  CoupledStep<Real> step(c, protocol.escape_velocity(), stages);
+  CoupledStep<Real> step(c, protocol.escape_velocity(), stages, std::move(device));
   const auto observables_stage = stages.declare(kObservablesStage);
   const auto output_stage = stages.declare(kOutputStage);
   const auto checkpoint_stage = stages.declare(kCheckpointStage);
@@ -208,6 +230,11 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     log.info("resumed from " + checkpoint.string() + " at step " + std::to_string(s.step));
   } else {
     place_spheres(c, modules, box, s.spheres);
+  }
+  if (liquid && liquid->device) {
+    liquid->to_device();
+    log.info("lattice and immersed boundary on GPU " +
+             std::to_string(liquid->device->gpu().index) + ", " + liquid->device->gpu().name);
   }
   log.info(
       std::string("flocsim ") + kFlocsimVersion + " " + std::string(cases::scene_name(c.scene)) +
@@ -246,6 +273,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     if (s.step % d.sample == 0) {
       {
         const auto timing = stages.time(observables_stage);
+        if (liquid) liquid->to_host();  // the GPU's lattice, where it has one
         const std::string sick = take_sample(c, step, protocol, s, slabs);
         if (!sick.empty()) return fail(sick);
       }
@@ -266,6 +294,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     const bool stop_now = shell.stop_requested(s.step);
     if (!done && (stop_now || shell.checkpoint_due(s.step, c.protocol.checkpoint_every_s))) {
       // only a healthy state is checkpointed: the last good one is never replaced by a bad one
+      if (liquid) liquid->to_host();
       const std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a,
                                       liquid ? liquid->fluid.total_mass() : 0.0);
       if (!sick.empty()) return fail(sick);
@@ -313,7 +342,10 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
              " steps in a row"}};
   stages.run(output_stage, [&] {
     write_series(o.out_dir, s, slabs, summary.distributions);
-    if (liquid) write_fields(o.out_dir, liquid->fluid);
+    if (liquid) {
+      liquid->to_host();
+      write_fields(o.out_dir, liquid->fluid);
+    }
   });
 
   const double wall = shell.wall_s();
@@ -332,6 +364,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   result["not_stationary"] = not_stationary(summary.observables, log);
   result["observables"] = std::move(summary.observables);
   result["cost"] = cost;
+  if (!device_record.is_null()) result["device"] = device_record;
   return shell.complete(std::move(result), wall,
                         std::to_string(s.step) + " steps (" +
                             std::to_string(s.step / c.derived.convective_time) + " a/U_inf)");

@@ -1,9 +1,8 @@
 // Where a case runs (engine/case/device.hpp): a GPU asked for where none can
-// be used is refused before any work, with the reason; sphere scenes refuse
-// cuda (their coupled step has no GPU code yet), and so does a sweep launched
-// on cuda over them, before it records anything. On a machine with a usable
-// GPU the first test has nothing to show and skips (test_gpu_lattice runs
-// the GPU itself there).
+// be used is refused before any work, with the reason, for the fluid scene and
+// a sphere scene alike, and so is a sweep launched on cuda, before it records
+// anything. On a machine with a usable GPU the refusals have nothing to show
+// and skip (test_gpu_lattice and test_gpu_coupling run the GPU itself there).
 #include <gtest/gtest.h>
 
 #include "cli_fixture.hpp"
@@ -40,15 +39,19 @@ TEST_F(Cli, DeviceCudaWithoutAUsableGpuIsRefusedBeforeAnyWork) {
   EXPECT_FALSE(result["case"].contains("device"));  // the default is not written
 }
 
-TEST_F(Cli, SphereScenesRefuseCudaBeforeAnyWork) {
+TEST_F(Cli, ASphereSceneOnCudaWithoutAUsableGpuIsRefusedBeforeAnyWork) {
+  const gpu::GpuQuery q = gpu::query_gpus();
+  if (!q.devices.empty()) GTEST_SKIP() << "a GPU is usable here: " << q.devices[0].name;
   t::write_text(dir_ / "case.json",
                 R"({"scene": "suspension", "fidelity": "draft", "phi": 0.2, "Re_inf": 6})");
   const fs::path out = dir_ / "out";
   const t::Output o = t::run(
       flocsim({"run", (dir_ / "case.json").string(), "--out", out.string(), "--device", "cuda"}));
   EXPECT_EQ(o.code, 2) << o.out;
-  EXPECT_NE(o.out.find("runs on the CPU only"), std::string::npos) << o.out;
-  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(o.out.find("device = \"cuda\""), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find(q.why_none), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("--device cpu"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(out)) << "work started: " << out;
 }
 
 TEST_F(Cli, SweepOnCudaIsRefusedBeforeAnythingIsRecorded) {
