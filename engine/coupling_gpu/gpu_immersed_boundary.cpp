@@ -79,26 +79,13 @@ void GpuImmersedBoundary<Real>::remove(GpuFluidLattice<Real>& liquid) {
 template <class Real>
 std::vector<coupling::NamedArray> GpuImmersedBoundary<Real>::memory() const {
   if (!settings_.scheme.control()) return {};
-  auto vectors = [](const std::vector<Real>& lanes) {  // (0, x, y, z) per marker -> x y z
-    std::vector<double> out;
-    out.reserve(3 * lanes.size() / 4);
-    for (std::size_t k = 0; k + 3 < lanes.size(); k += 4)
-      for (int d = 1; d <= 3; ++d) out.push_back(static_cast<double>(lanes[k + d]));
-    return out;
-  };
-  return {{"marker_force", vectors(kernels_->marker_force())},
-          {"marker_slip", vectors(kernels_->marker_slip())}};
+  return {{"marker_force", immersed_boundary::lanes_to_vectors(kernels_->marker_force())},
+          {"marker_slip", immersed_boundary::lanes_to_vectors(kernels_->marker_slip())}};
 }
 
 template <class Real>
 void GpuImmersedBoundary<Real>::restore_memory(const std::vector<coupling::NamedArray>& memory) {
   if (!settings_.scheme.control()) return;
-  auto lanes = [](const std::vector<double>& v) {
-    std::vector<Real> out(4 * (v.size() / 3), Real(0));
-    for (std::size_t k = 0; k < v.size() / 3; ++k)
-      for (int d = 0; d < 3; ++d) out[4 * k + 1 + d] = static_cast<Real>(v[3 * k + d]);
-    return out;
-  };
   std::vector<Real> force, slip;
   for (const auto& a : memory) {
     if (a.values.size() % (3 * static_cast<std::size_t>(markers_)) != 0)
@@ -106,8 +93,8 @@ void GpuImmersedBoundary<Real>::restore_memory(const std::vector<coupling::Named
                                   std::to_string(a.values.size()) +
                                   " numbers, not 3 per marker of whole spheres (" +
                                   std::to_string(markers_) + " markers each)");
-    if (a.name == "marker_force") force = lanes(a.values);
-    if (a.name == "marker_slip") slip = lanes(a.values);
+    if (a.name == "marker_force") force = immersed_boundary::vectors_to_lanes<Real>(a.values);
+    if (a.name == "marker_slip") slip = immersed_boundary::vectors_to_lanes<Real>(a.values);
   }
   kernels_->restore(force, slip);
 }

@@ -695,25 +695,13 @@ void ImmersedBoundary<Real>::apply_with_kernel(lattice::ForcedLiquid<Real>& liqu
 template <class Real>
 std::vector<coupling::NamedArray> ImmersedBoundary<Real>::memory() const {
   if (!settings_.scheme.control()) return {};
-  auto vectors = [](const std::vector<Real>& lanes) {  // (0, x, y, z) per marker -> x y z
-    std::vector<double> out;
-    out.reserve(3 * lanes.size() / 4);
-    for (std::size_t k = 0; k + 3 < lanes.size(); k += 4)
-      for (int d = 1; d <= 3; ++d) out.push_back(static_cast<double>(lanes[k + d]));
-    return out;
-  };
-  return {{"marker_force", vectors(marker_force_)}, {"marker_slip", vectors(marker_slip_)}};
+  return {{"marker_force", lanes_to_vectors(marker_force_)},
+          {"marker_slip", lanes_to_vectors(marker_slip_)}};
 }
 
 template <class Real>
 void ImmersedBoundary<Real>::restore_memory(const std::vector<coupling::NamedArray>& memory) {
   if (!settings_.scheme.control()) return;
-  auto lanes = [](const std::vector<double>& v) {
-    std::vector<Real> out(4 * (v.size() / 3), Real(0));
-    for (std::size_t k = 0; k < v.size() / 3; ++k)
-      for (int d = 0; d < 3; ++d) out[4 * k + 1 + d] = static_cast<Real>(v[3 * k + d]);
-    return out;
-  };
   for (const auto& a : memory) {
     if (a.values.size() % (3 * static_cast<std::size_t>(markers_per_sphere())) != 0)
       throw std::invalid_argument("immersed boundary: checkpointed " + a.name + " holds " +
@@ -721,9 +709,9 @@ void ImmersedBoundary<Real>::restore_memory(const std::vector<coupling::NamedArr
                                   " numbers, not 3 per marker of whole spheres (" +
                                   std::to_string(markers_per_sphere()) + " markers each)");
     if (a.name == "marker_force")
-      marker_force_ = lanes(a.values);
+      marker_force_ = vectors_to_lanes<Real>(a.values);
     else if (a.name == "marker_slip")
-      marker_slip_ = lanes(a.values);
+      marker_slip_ = vectors_to_lanes<Real>(a.values);
   }
 }
 

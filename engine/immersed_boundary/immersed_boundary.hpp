@@ -92,6 +92,25 @@ int sphere_box_edge(double input_radius);
 // kernel cells must not meet its own periodic image.
 void check_box_fits(const lattice::Extent& extent, double input_radius);
 
+// Control forcing's carried state as checkpoints hold it (x y z per marker)
+// and as the couplings keep it ((0, x, y, z) per marker, in Real), both
+// ways: the CPU and GPU couplings write and read the same checkpoint.
+template <class Real>
+std::vector<double> lanes_to_vectors(const std::vector<Real>& lanes) {
+  std::vector<double> out;
+  out.reserve(3 * lanes.size() / 4);
+  for (std::size_t k = 0; k + 3 < lanes.size(); k += 4)
+    for (int d = 1; d <= 3; ++d) out.push_back(static_cast<double>(lanes[k + d]));
+  return out;
+}
+template <class Real>
+std::vector<Real> vectors_to_lanes(const std::vector<double>& v) {
+  std::vector<Real> out(4 * (v.size() / 3), Real(0));
+  for (std::size_t k = 0; k < v.size() / 3; ++k)
+    for (int d = 0; d < 3; ++d) out[4 * k + 1 + d] = static_cast<Real>(v[3 * k + d]);
+  return out;
+}
+
 template <class Real>
 class ImmersedBoundary final : public coupling::SphereCoupling<Real> {
  public:

@@ -114,15 +114,8 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   // date by a download before each read, so they are the CPU run's code
   // unchanged. The GPU's memory is taken before the output folder is
   // touched, so a GPU that cannot hold the lattice refuses the run up front.
-  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
-  if (c.device == cases::Device::cuda) {
-    try {
-      device = std::make_unique<gpu::GpuFluidLattice<Real>>(c.size, c.relaxation);
-    } catch (const std::exception& e) {
-      throw input::InputError(std::string("device = \"cuda\": ") + e.what() +
-                              "; run on the CPU with --device cpu");
-    }
-  }
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device =
+      lattice_on_gpu<Real>(c.device == cases::Device::cuda, c.size, c.relaxation);
   RunShell shell(o, c.to_json(), c.warnings, c.run.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
   RunLog& log = shell.log();
@@ -154,11 +147,7 @@ RunReport run_with_precision(const cases::FluidCase& c, const RunOptions& o) {
   if (device) {
     device->upload(fluid);
     const gpu::GpuDevice& g = device->gpu();
-    device_record = {{"kind", "cuda"},
-                     {"name", g.name},
-                     {"memory_gib", g.memory_gib},
-                     {"compute_capability",
-                      std::to_string(g.compute_major) + "." + std::to_string(g.compute_minor)}};
+    device_record = gpu_device_record(g);
     log.info("lattice on GPU " + std::to_string(g.index) + ", " + g.name);
   }
   const auto time_step = [&] { return device ? device->time_step() : fluid.time_step(); };

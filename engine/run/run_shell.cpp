@@ -74,6 +74,14 @@ RunReport RunShell::blown_up(const std::string& where, const std::string& what,
   return blown_up_run(log_, where, what, last_good_checkpoint_, checkpoint_, likely_causes);
 }
 
+nlohmann::json gpu_device_record(const gpu::GpuDevice& g) {
+  return {{"kind", "cuda"},
+          {"name", g.name},
+          {"memory_gib", g.memory_gib},
+          {"compute_capability",
+           std::to_string(g.compute_major) + "." + std::to_string(g.compute_minor)}};
+}
+
 nlohmann::json cpu_device_record() {
   std::string model = "unknown CPU";
   std::ifstream info("/proc/cpuinfo");

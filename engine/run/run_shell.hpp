@@ -8,11 +8,14 @@
 // checkpoint's content.
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "engine/input/input_reader.hpp"
+#include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
 #include "engine/run/output_directory.hpp"
 #include "engine/run/run_log.hpp"
 #include "engine/run/run_types.hpp"
@@ -81,8 +84,26 @@ class RunShell {
 };
 
 // result.json's "device" of a run on the CPU: {"kind": "cpu", "name": the
-// processor's model, "threads"}; a run on a GPU records its own (fluid_run.cpp).
+// processor's model, "threads"}.
 nlohmann::json cpu_device_record();
+// result.json's "device" of a run on a GPU: {"kind": "cuda", "name",
+// "memory_gib", "compute_capability"}.
+nlohmann::json gpu_device_record(const gpu::GpuDevice& g);
+
+// The lattice of a case on "cuda", taken on the GPU before the output folder
+// is touched, so that a GPU that cannot hold it refuses the run up front
+// (input::InputError with the reason and what works); null for the CPU.
+template <class Real>
+std::unique_ptr<gpu::GpuFluidLattice<Real>> lattice_on_gpu(bool on_gpu, lattice::Extent extent,
+                                                           lattice::Relaxation relaxation) {
+  if (!on_gpu) return nullptr;
+  try {
+    return std::make_unique<gpu::GpuFluidLattice<Real>>(extent, relaxation);
+  } catch (const std::exception& e) {
+    throw input::InputError(std::string("device = \"cuda\": ") + e.what() +
+                            "; run on the CPU with --device cpu");
+  }
+}
 
 // Runs a scene's loop and turns a module's failure (event cap, I/O such as a
 // full disk) into a failed run; a refused input stays an input::InputError.

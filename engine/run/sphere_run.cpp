@@ -175,25 +175,10 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   // On a GPU the lattice and the immersed boundary step there (Liquid in
   // coupled_step.hpp); its memory is taken before the output folder is
   // touched, so a GPU that cannot hold the lattice refuses the run up front.
-  std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
-  if (c.device == cases::Device::cuda) {
-    try {
-      device = std::make_unique<gpu::GpuFluidLattice<Real>>(
-          c.derived.box, lattice::Relaxation{c.numerics.viscosity, c.numerics.trt_magic});
-    } catch (const std::exception& e) {
-      throw input::InputError(std::string("device = \"cuda\": ") + e.what() +
-                              "; run on the CPU with --device cpu");
-    }
-  }
-  nlohmann::json device_record;
-  if (device) {
-    const gpu::GpuDevice& g = device->gpu();
-    device_record = {{"kind", "cuda"},
-                     {"name", g.name},
-                     {"memory_gib", g.memory_gib},
-                     {"compute_capability",
-                      std::to_string(g.compute_major) + "." + std::to_string(g.compute_minor)}};
-  }
+  std::unique_ptr<gpu::GpuFluidLattice<Real>> device = lattice_on_gpu<Real>(
+      c.device == cases::Device::cuda, c.derived.box,
+      {c.numerics.viscosity, c.numerics.trt_magic});
+  const nlohmann::json device_record = device ? gpu_device_record(device->gpu()) : nlohmann::json();
   RunShell shell(o, c.to_json(), c.warnings, c.protocol.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
   RunLog& log = shell.log();

@@ -22,11 +22,16 @@
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
+#include "tests/immersed_boundary/coupling_scenes.hpp"
 #include "tests/lattice/lattice_probes.hpp"
 
 namespace flocsim::gpu {
 namespace {
 
+using testing::stir;
+using testing::control;
+using testing::direct;
+using testing::three_spheres;
 using immersed_boundary::ImmersedBoundary;
 using immersed_boundary::ImmersedBoundarySettings;
 using spheres::Vec3;
@@ -34,30 +39,6 @@ using spheres::Vec3;
 template <class Real>
 constexpr double kRoundOff = sizeof(Real) == 8 ? 1e-12 : 1e-4;
 
-template <class Real>
-void stir(lattice::FluidLattice<Real>& fluid) {
-  const lattice::Extent e = fluid.extent();
-  fluid.set_body_force({2e-5, -1e-5, 3e-6});
-  const double k = 2 * M_PI;
-  fluid.initialise_equilibrium([&](int x, int y, int z) {
-    lattice::Macroscopic m;
-    m.density = 1.0 + 0.01 * std::sin(k * (x + 2 * y) / e.nx);
-    m.velocity = {0.02 * std::sin(k * y / e.ny), 0.01 * std::cos(k * z / e.nz),
-                  0.015 * std::sin(k * x / e.nx)};
-    return m;
-  });
-}
-
-spheres::SphereSet three_spheres() {
-  spheres::SphereSet s;
-  s.radius = 4.0;
-  s.resize(3);
-  s.position = {Vec3(12.3, 14.6, 13.1), Vec3(20.9, 15.2, 12.4), Vec3(0.4, 24.7, 27.8)};
-  s.velocity = {Vec3(0.01, -0.005, 0.002), Vec3(-0.004, 0.003, 0.006), Vec3(0.0, 0.0, -0.008)};
-  s.angular_velocity = {Vec3(0.001, 0.0, -0.002), Vec3(0.0, 0.0015, 0.0),
-                        Vec3(-0.001, 0.001, 0.0005)};
-  return s;
-}
 
 double largest(const std::vector<Vec3>& v) {
   double m = 0;
@@ -125,20 +106,6 @@ void expect_same_steps(const coupling::Scheme& scheme, int steps) {
   }
 }
 
-coupling::Scheme direct(int sweeps, coupling::Kernel kernel) {
-  coupling::Scheme s;
-  s.sweeps = sweeps;
-  s.kernel = kernel;
-  return s;
-}
-
-coupling::Scheme control() {
-  coupling::Scheme s;
-  s.forcing = coupling::Forcing::control;
-  s.sweeps = 1;
-  s.gains = {1.5, 0.5};
-  return s;
-}
 
 TEST(GpuCoupling, DirectForcingStepsMatchTheCpuCoupling) {
   expect_same_steps<double>(direct(1, coupling::Kernel::roma3), 3);

@@ -28,11 +28,16 @@
 #include "engine/immersed_boundary/marker_body.hpp"
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
+#include "tests/immersed_boundary/coupling_scenes.hpp"
 #include "tests/lattice/lattice_probes.hpp"
 
 namespace flocsim::immersed_boundary {
 namespace {
 
+using testing::stir;
+using testing::control;
+using testing::direct;
+using testing::three_spheres;
 using spheres::Vec3;
 
 struct PlainAdd {
@@ -176,35 +181,6 @@ void serial_apply(const gpu::MarkerSetup& setup, const lattice::AaSlots<Real>& s
   }
 }
 
-// A liquid with a little of everything: shear in three directions, a
-// density wave and a body force, one step old (odd parity).
-template <class Real>
-void stir(lattice::FluidLattice<Real>& fluid) {
-  const lattice::Extent e = fluid.extent();
-  fluid.set_body_force({2e-5, -1e-5, 3e-6});
-  const double k = 2 * M_PI;
-  fluid.initialise_equilibrium([&](int x, int y, int z) {
-    lattice::Macroscopic m;
-    m.density = 1.0 + 0.01 * std::sin(k * (x + 2 * y) / e.nx);
-    m.velocity = {0.02 * std::sin(k * y / e.ny), 0.01 * std::cos(k * z / e.nz),
-                  0.015 * std::sin(k * x / e.nx)};
-    return m;
-  });
-  fluid.step();
-}
-
-// Three spheres: two whose boxes (and kernels) overlap, one across the
-// periodic wrap in x and z, each moving and turning differently.
-spheres::SphereSet three_spheres() {
-  spheres::SphereSet s;
-  s.radius = 4.0;
-  s.resize(3);
-  s.position = {Vec3(12.3, 14.6, 13.1), Vec3(20.9, 15.2, 12.4), Vec3(0.4, 24.7, 27.8)};
-  s.velocity = {Vec3(0.01, -0.005, 0.002), Vec3(-0.004, 0.003, 0.006), Vec3(0.0, 0.0, -0.008)};
-  s.angular_velocity = {Vec3(0.001, 0.0, -0.002), Vec3(0.0, 0.0015, 0.0),
-                        Vec3(-0.001, 0.001, 0.0005)};
-  return s;
-}
 
 double largest(const std::vector<double>& v) {
   double m = 0;
@@ -256,6 +232,7 @@ void expect_serial_launcher_matches_cpu(coupling::Scheme scheme, int steps) {
   const lattice::Extent e{32, 30, 28};
   lattice::FluidLattice<Real> fluid(e, {0.02, 0.25});
   stir(fluid);
+  fluid.step();  // one step old: the odd parity first
   const ImmersedBoundarySettings settings{.input_radius = 3.7, .scheme = scheme};
   ImmersedBoundary<Real> cpu(settings);
   const gpu::MarkerSetup setup = gpu::marker_setup(settings);
@@ -292,20 +269,6 @@ void expect_serial_launcher_matches_cpu(coupling::Scheme scheme, int steps) {
   }
 }
 
-coupling::Scheme direct(int sweeps, coupling::Kernel kernel) {
-  coupling::Scheme s;
-  s.sweeps = sweeps;
-  s.kernel = kernel;
-  return s;
-}
-
-coupling::Scheme control() {
-  coupling::Scheme s;
-  s.forcing = coupling::Forcing::control;
-  s.sweeps = 1;
-  s.gains = {1.5, 0.5};  // a proportional part too, so that the carried slip matters
-  return s;
-}
 
 TEST(MarkerBody, OneSweepRomaMatchesTheCpuCouplingInDouble) {
   expect_serial_launcher_matches_cpu<double, 3>(direct(1, coupling::Kernel::roma3), 2);
