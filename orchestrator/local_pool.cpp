@@ -20,6 +20,7 @@
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/output_directory.hpp"
 #include "orchestrator/process.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -114,7 +115,7 @@ std::string short_id(const std::string& id) {
 }
 
 void say(std::ostream* out, const std::string& line) {
-  if (out) *out << line << std::endl;
+  if (out) *out << printable(line) << std::endl;  // names a run folder, a host, a reason
 }
 
 // DIR/result.json read as this run's result: complete, and of this run's case.
@@ -152,7 +153,7 @@ bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::Ru
   if (!rr.record) {
     // not an error yet (the worker may replace it), but never silent
     if (out && rr.problem.find("another case") != std::string::npos)
-      *out << "not recorded " << run.id.substr(0, 12) << ": " << rr.problem << std::endl;
+      *out << "not recorded " << run.id.substr(0, 12) << ": " << printable(rr.problem) << std::endl;
     return false;
   }
   db.record_result(attempt_id, *rr.record);

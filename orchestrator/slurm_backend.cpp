@@ -22,6 +22,7 @@
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -69,7 +70,7 @@ std::string shell_quote(const std::string& s) {
 }
 
 void say(std::ostream* out, const std::string& line) {
-  if (out) *out << line << std::endl;
+  if (out) *out << printable(line) << std::endl;  // names a job, a path, Slurm's reason
 }
 
 // Where execvp would find `program` ("" when nowhere): run_program's -1 says
@@ -366,7 +367,7 @@ int cancel_all(db::ResultsDb& db, std::ostream& out) {
   for (const std::string& j : jobs) {
     std::string text;
     const int rc = run_program({"scancel", j}, &text);
-    out << "scancel " << j << (rc == 0 ? "" : ": failed: " + text) << "\n";
+    out << "scancel " << printable(j) << (rc == 0 ? "" : ": failed: " + printable(text)) << "\n";
   }
   if (owners.empty() && jobs.empty()) out << "nothing is running\n";
   return static_cast<int>(owners.size() + jobs.size());

@@ -339,10 +339,10 @@ const bool registered = register_command(
              const std::string runs_dir =
                  o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
              const orc::Registered reg = orc::register_sweep(db, spec, runs_dir);
-             std::cout << "sweep " << orc::terminal_text(spec.name) << ": " << reg.runs << " runs ("
+             std::cout << "sweep " << orc::printable(spec.name) << ": " << reg.runs << " runs ("
                        << reg.added.added << " new, " << reg.added.reused << " already in "
-                       << o->db_path << "); run folders under "
-                       << std::filesystem::absolute(runs_dir).string() << "\n";
+                       << orc::printable(o->db_path) << "); run folders under "
+                       << orc::printable(std::filesystem::absolute(runs_dir).string()) << "\n";
              return run_sweep(*o, db, reg.sweep,
                               {RunState::kPending, RunState::kInterrupted, RunState::kLost}, gpus);
            }
@@ -375,7 +375,7 @@ const bool registered = register_command(
              } catch (const db::ReadOnlyDbError& e) {
                writable = false;
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
-               std::cout << o->db_path
+               std::cout << orc::printable(o->db_path)
                          << (dynamic_cast<const db::DiskFullDbError*>(&e)
                                  ? ": the file system under it is full (free some space)"
                                  : " is read-only")
@@ -408,10 +408,10 @@ const bool registered = register_command(
              return orc::run_slurm_task(db, sweep, o->task_file, o->worker, o->lease_s, std::cout);
            }
          } catch (const flocsim::input::InputError& e) {
-           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitBadInput;
          } catch (const db::DbError& e) {
-           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitFailure;
          }
          return kExitBadInput;

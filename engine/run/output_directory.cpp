@@ -11,6 +11,7 @@
 #include "engine/coupling/scheme.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
+#include "engine/text/printable.hpp"
 
 namespace flocsim::run {
 
@@ -171,7 +172,7 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
                                aside.string() + ", the run " +
                                (checkpoint ? "continues from its checkpoint" : "starts again");
       RunLog(dir / "run.log", true).warning(note);
-      std::cerr << "flocsim run: warning: " << note << "\n";
+      std::cerr << "flocsim run: warning: " << text::printable(note) << "\n";
       completed = false;
     }
   }

@@ -14,6 +14,8 @@
 #include <sstream>
 #include <tuple>
 
+#include <sqlite3.h>
+
 #include "db/results_db.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "harness.hpp"
@@ -486,6 +488,123 @@ TEST_F(Orchestrator, ControlAndBidiCharactersAreShownEscaped) {
   EXPECT_NE(l.out.find("evil\\u202egpj.exe"), std::string::npos) << l.out;
   EXPECT_NE(st.out.find("sweep n\\x1b[2Ja\\u202eme"), std::string::npos) << st.out;
   EXPECT_NE(q.out.find("\\u202e"), std::string::npos) << q.out;
+}
+
+// Bytes a terminal obeys, or that are not UTF-8, among those the test below
+// puts into names, values, paths and messages: none may reach the output raw.
+// Newlines are the output's own, so a name's newline is checked by finding
+// the name whole, escaped, in one line.
+std::string raw_bytes_in(const std::string& out) {
+  std::string found;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto b = static_cast<unsigned char>(out[i]);
+    if ((b < 0x20 && b != '\n') || b == 0x7f || b == 0xff || b == 0xfe ||
+        out.compare(i, 2, "\xc2\x9b") == 0 || out.compare(i, 3, "\xe2\x80\xae") == 0)
+      found += "byte " + std::to_string(b) + " at " + std::to_string(i) + "; ";
+  }
+  return found;
+}
+
+// Issue 41, item 7, the rest: a hostile database (names, points, messages,
+// bytes that are not UTF-8, a newline in a name) and hostile command-line
+// words reached the terminal raw through status, query, resume's progress
+// lines, the suggested commands and the error messages on stderr.
+TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
+  const std::string sweep = fake_sweep({1, 2}, 1, 1, {{"by_x", {{"2", {{"exit", 1}}}}}}, 5);
+  ASSERT_EQ(t::run(launch(sweep)).code, 1);
+  // U+001B [31m, U+202E, a newline, the byte 0xFF, U+009B (C1 CSI)
+  const std::string hostile = "n\x1b[31m\xe2\x80\xae\nx\xff\xc2\x9b";
+  const std::string shown = "n\\x1b[31m\\u202e\\x0ax\\xff\\u009b";
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(db_.c_str(), &db), SQLITE_OK);
+    const auto exec = [&](const char* sql, const std::string& a) {
+      sqlite3_stmt* st = nullptr;
+      ASSERT_EQ(sqlite3_prepare_v2(db, sql, -1, &st, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+      sqlite3_bind_text(st, 1, a.data(), static_cast<int>(a.size()), SQLITE_TRANSIENT);
+      EXPECT_EQ(sqlite3_step(st), SQLITE_DONE) << sqlite3_errmsg(db);
+      sqlite3_finalize(st);
+    };
+    exec("UPDATE sweeps SET name = ?1", hostile);
+    // a point that is JSON (its value holds ESC and U+202E as JSON escapes)
+    // for the failed run, one that is not for the completed run
+    exec("UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+         "(SELECT id FROM runs WHERE status = 'failed')",
+         R"({"x":"v\u001b[31m\u202e"})");
+    exec("UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+         "(SELECT id FROM runs WHERE status = 'completed')",
+         "{\"x\":\"\xff\"}");
+    exec("UPDATE runs SET error = ?1 WHERE status = 'failed'", "boom\x1b]0;title\x07 \xe2\x80\xae");
+    sqlite3_close(db);
+  }
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_EQ(st.code, 0) << st.out;
+  EXPECT_EQ(raw_bytes_in(st.out), "") << st.out;
+  EXPECT_NE(st.out.find("sweep " + shown + ": 2 runs:"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("x=v\\x1b[31m\\u202e"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("boom\\x1b]0;title\\x07 \\u202e"), std::string::npos) << st.out;
+  // the suggested command: bash's $'...', the name's bytes as \xNN
+  const std::string quoted = "$'n\\x1b[31m\\xe2\\x80\\xae\\x0ax\\xff\\xc2\\x9b'";
+  EXPECT_NE(st.out.find("--sweep " + quoted), std::string::npos) << st.out;
+
+  for (const std::string format : {"table", "csv", "json"}) {
+    const t::Output q =
+        t::run(flocsim({"query", "--db", db_, "--sweep", hostile, "--format", format, "--all"}));
+    EXPECT_EQ(q.code, 0) << format << ": " << q.out;
+    EXPECT_EQ(raw_bytes_in(q.out), "") << format << ": " << q.out;
+  }
+  const t::Output j = t::run(flocsim({"query", "--db", db_, "--format", "json"}));
+  // JSON keeps the message (ESC and U+202E as JSON's escapes)
+  EXPECT_NE(j.out.find(R"("error": "boom\u001b]0;title\u0007 \u202e")"), std::string::npos)
+      << j.out;
+
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_, "--sweep", hostile,
+                                      "--worker", FAKE_WORKER_EXE}));
+  EXPECT_EQ(r.code, 1) << r.out;  // x = 2 fails again
+  EXPECT_EQ(raw_bytes_in(r.out), "") << r.out;
+  EXPECT_NE(r.out.find("x=v\\x1b[31m\\u202e"), std::string::npos) << r.out;  // started ...
+  EXPECT_NE(r.out.find("--sweep " + quoted), std::string::npos) << r.out;
+
+  // stderr: the words given, as messages quote them
+  const std::string word = "zz\x1b[31m\n\xe2\x80\xae\xff";
+  const t::Output e1 = t::run(flocsim({"sweep", "status", "--db", db_, "--sweep", word}));
+  EXPECT_EQ(e1.code, 2) << e1.out;
+  EXPECT_EQ(raw_bytes_in(e1.out), "") << e1.out;
+  EXPECT_NE(e1.out.find("--sweep zz\\x1b[31m\\x0a\\u202e\\xff: no such sweep in "),
+            std::string::npos)
+      << e1.out;
+  const std::string missing_db = (dir_ / ("d" + word + ".db")).string();
+  for (const auto& args :
+       {std::vector<std::string>{"sweep", "status", "--db", missing_db},
+        std::vector<std::string>{"query", "--db", missing_db},
+        std::vector<std::string>{"run", missing_db, "--out", missing_db},
+        std::vector<std::string>{"sweep", "launch", missing_db, "--db", missing_db},
+        std::vector<std::string>{"sweep", "status", "--db", db_, "--lease", word},
+        std::vector<std::string>{word}}) {
+    const t::Output e = t::run(flocsim(args));
+    EXPECT_NE(e.code, 0) << args.front() << ": " << e.out;
+    EXPECT_EQ(raw_bytes_in(e.out), "") << args.front() << ": " << e.out;
+    EXPECT_NE(e.out.find("zz\\x1b[31m\\x0a\\u202e\\xff"), std::string::npos) << e.out;
+  }
+  EXPECT_FALSE(fs::exists(missing_db));
+
+  // launch: a sweep name from a file (ESC and U+202E as JSON escapes), a
+  // database and a runs folder whose paths hold them too
+  json s = t::read_json(sweep);
+  s["name"] = "l\x1b[31m\xe2\x80\xae";
+  t::write_text(dir_ / "l.json", s.dump());
+  const std::string odd = (dir_ / "o\x1b[31m\xe2\x80\xae").string();
+  fs::create_directories(odd);
+  const t::Output l =
+      t::run(flocsim({"sweep", "launch", (dir_ / "l.json").string(), "--db", odd + "/r.db",
+                      "--runs-dir", odd + "/runs", "--worker", FAKE_WORKER_EXE}));
+  EXPECT_EQ(l.code, 1) << l.out;
+  EXPECT_EQ(raw_bytes_in(l.out), "") << l.out;
+  EXPECT_NE(l.out.find("sweep l\\x1b[31m\\u202e: 2 runs (2 new, 0 already in " + dir_.string() +
+                       "/o\\x1b[31m\\u202e/r.db); run folders under " + dir_.string() +
+                       "/o\\x1b[31m\\u202e/runs"),
+            std::string::npos)
+      << l.out;
 }
 
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
