@@ -56,11 +56,15 @@ std::string default_worker() {
       "cannot find the flocsim executable to run as the worker; give --worker PATH");
 }
 
-// Refuses a --worker that cannot be started, before any run is claimed: a
-// missing one failed every run with exit 127, naming no path, and each
-// failure used up one of the run's attempts.
-void check_worker(const std::string& worker) {
+// Refuses a --worker (or $FLOCSIM_WORKER) that cannot be started, before any
+// run is claimed: a missing one failed every run with exit 127, naming no
+// path, and each failure used up one of the run's attempts.
+void check_worker(const std::string& given) {
+  // the worker the runs would get: --worker, else $FLOCSIM_WORKER, else this flocsim
+  const char* env = std::getenv("FLOCSIM_WORKER");
+  const std::string worker = !given.empty() ? given : env && *env ? env : "";
   if (worker.empty()) return;  // this flocsim
+  const std::string option = !given.empty() ? "--worker " : "FLOCSIM_WORKER=";
   std::string found;
   if (worker.find('/') != std::string::npos) {
     found = worker;
@@ -72,21 +76,21 @@ void check_worker(const std::string& worker) {
       if (access(p.c_str(), X_OK) == 0 && !std::filesystem::is_directory(p)) found = p.string();
     }
     if (found.empty())
-      throw flocsim::input::InputError("--worker " + worker + ": not found on PATH (" +
+      throw flocsim::input::InputError(option + worker + ": not found on PATH (" +
                                        (path ? path : "unset") +
                                        "); give the worker program's path");
   }
   std::error_code ec;
   if (!std::filesystem::exists(found, ec))
-    throw flocsim::input::InputError("--worker " + worker + ": no such file" +
+    throw flocsim::input::InputError(option + worker + ": no such file" +
                                      (ec ? " (" + ec.message() + ")" : std::string()) +
                                      "; give the path of a program run as `WORKER run CASE "
                                      "--out DIR` (default: this flocsim)");
   if (std::filesystem::is_directory(found, ec))
-    throw flocsim::input::InputError("--worker " + worker +
+    throw flocsim::input::InputError(option + worker +
                                      ": is a directory; give the worker program's path");
   if (access(found.c_str(), X_OK) != 0)
-    throw flocsim::input::InputError("--worker " + worker + ": cannot be run (" +
+    throw flocsim::input::InputError(option + worker + ": cannot be run (" +
                                      std::strerror(errno) + "); allowed: an executable file");
 }
 

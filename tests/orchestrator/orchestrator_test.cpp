@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -605,6 +606,51 @@ TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
                        "/o\\x1b[31m\\u202e/runs"),
             std::string::npos)
       << l.out;
+}
+
+// Found by scripts/probe-cli.sh, beside issue 41's items 10 and 13: an sbatch
+// whose answer is not a job id was reported as "submitted job not a job id"
+// (exit 0); an sbatch that never answers held the launch through SIGTERM; and
+// a missing $FLOCSIM_WORKER, unlike --worker, was only found by failing runs.
+TEST_F(Orchestrator, SbatchWithoutAJobIdOrAnswerAndAMissingEnvWorkerAreSaid) {
+  const fs::path bin = dir_ / "fake-slurm";
+  fs::create_directories(bin);
+  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+  t::write_text(bin / "sbatch", "#!/bin/sh\necho 'sbatch: queued somewhere'\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  fs::permissions(bin / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  const std::string sweep = fake_sweep({1}, 1, 1);
+  const t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--backend", "slurm",
+                                      "--no-wait", "--worker", FAKE_WORKER_EXE}),
+                             {path});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("answered \"sbatch: queued somewhere"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("where --parsable gives the job id"), std::string::npos) << o.out;
+  EXPECT_EQ(o.out.find("submitted job"), std::string::npos) << o.out;
+
+  t::write_text(bin / "sbatch", "#!/bin/sh\ntouch \"$(dirname \"$0\")/asked\"\nexec sleep 60\n");
+  // env execs flocsim: the pid is flocsim's
+  t::Background b = t::start({"/usr/bin/env", path, FLOCSIM_EXE, "sweep", "resume", "--db", db_,
+                              "--backend", "slurm", "--no-wait", "--worker", FAKE_WORKER_EXE},
+                             (dir_ / "hung.log").string());
+  ASSERT_TRUE(t::wait_for([&] { return fs::exists(bin / "asked"); }, 20));  // sbatch runs
+  kill(b.pid, SIGTERM);
+  const auto begin = std::chrono::steady_clock::now();
+  EXPECT_EQ(b.wait(20), 1) << t::read_text(dir_ / "hung.log");
+  EXPECT_LT(std::chrono::steady_clock::now() - begin, std::chrono::seconds(10));
+  EXPECT_NE(t::read_text(dir_ / "hung.log").find("stopped: flocsim was asked to stop"),
+            std::string::npos)
+      << t::read_text(dir_ / "hung.log");
+
+  const std::string missing = (dir_ / "no-such-worker").string();
+  const t::Output e =
+      t::run(flocsim({"sweep", "resume", "--db", db_}), {"FLOCSIM_WORKER=" + missing});
+  EXPECT_EQ(e.code, 2) << e.out;
+  EXPECT_NE(e.out.find("FLOCSIM_WORKER=" + missing + ": no such file"), std::string::npos)
+      << e.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 0);
 }
 
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
