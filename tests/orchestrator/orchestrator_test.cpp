@@ -397,6 +397,53 @@ TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
   EXPECT_TRUE(fs::exists(run_dir(2) / "result.json"));
 }
 
+// Found by scripts/probe-cli.sh after item 1's fix: with the real worker,
+// another case's result.json in a run folder made `flocsim run --resume`
+// refuse (exit 2), so the run became `refused` for good ("change the case")
+// though its case was fine. The attempt now fails without starting a worker,
+// saying to move the file; once it is moved, the next resume runs the case.
+TEST_F(Orchestrator, AnotherCasesResultInARunFolderFailsTheAttemptUntilMoved) {
+  const auto tiny = [](double viscosity) {
+    return json{{"scene", "fluid"},
+                {"fluid",
+                 {{"size", {16, 4, 4}},
+                  {"viscosity", viscosity},
+                  {"initial",
+                   {{"type", "shear_wave"}, {"amplitude", 0.01}, {"axis", "x"}, {"component", "y"}}}}},
+                {"run", {{"steps", 20}, {"threads", 1}}}};
+  };
+  t::write_text(dir_ / "other.json", tiny(0.02).dump());
+  ASSERT_EQ(t::run(flocsim({"run", (dir_ / "other.json").string(), "--out",
+                            (dir_ / "other").string(), "--quiet"}))
+                .code,
+            0);
+  t::write_text(dir_ / "s.json",
+                json{{"name", "s"}, {"base", tiny(0.04)}, {"axes", {{"run.steps", {20}}}}}.dump());
+  EXPECT_EQ(t::run(flocsim({"sweep", "launch", (dir_ / "s.json").string(), "--db", db_,
+                            "--worker", "/bin/false"}))
+                .code,
+            1);
+  const fs::path folder = ResultsDb(db_, ResultsDb::Mode::kExisting).runs().front().run_dir;
+  fs::copy_file(dir_ / "other" / "result.json", folder / "result.json");
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_}));
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("no worker was started: move it out of the run folder"), std::string::npos)
+      << r.out;
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    EXPECT_EQ(to_string(db.runs().front().status), "failed") << db.runs().front().error;
+  }
+  EXPECT_TRUE(fs::exists(folder / "result.json"));  // not flocsim's to remove
+  fs::rename(folder / "result.json", dir_ / "moved.json");
+  const t::Output again = t::run(flocsim({"sweep", "resume", "--db", db_}));
+  EXPECT_EQ(again.code, 0) << again.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  ASSERT_EQ(db.result_rows().size(), 1u);
+  ASSERT_TRUE(db.result_rows().front().has_result);
+  const json result = json::parse(db.result_rows().front().result_json);
+  EXPECT_EQ(result["case"]["fluid"]["viscosity"], 0.04);
+}
+
 // Issue 41, item 6: the printed "restart what did not finish with: flocsim
 // sweep resume ... --sweep NAME" left the name unquoted, and a sweep named
 // $(touch${IFS}X) ran touch when the line was pasted into a shell.
