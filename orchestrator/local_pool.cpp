@@ -324,9 +324,9 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
       // a hint (another --out) a sweep cannot follow. The attempt fails
       // instead, saying what to move; the next resume retries the run.
       if (found.foreign) {
-        const std::string why =
-            found.problem + "; no worker was started: move it out of the run folder, then " +
-            "resume the sweep";
+        const std::string why = found.problem +
+                                "; no worker was started: move it out of the run folder, then " +
+                                "resume the sweep";
         db.end_attempt(claim->attempt_id, RunState::kFailed, std::nullopt, std::nullopt, why);
         ++sum.failed;
         say(o.out, progress_tag() + " failed   " + short_id(run.id) + " " +

@@ -37,8 +37,7 @@ namespace {
 // exit code, or -1 when it could not be run. A `stoppable` one is ended
 // (SIGTERM, then SIGKILL) when flocsim is asked to stop: an sbatch that never
 // answers otherwise held flocsim in read() through every Ctrl-C and SIGTERM.
-int run_program(const std::vector<std::string>& argv, std::string* output,
-                bool stoppable = false) {
+int run_program(const std::vector<std::string>& argv, std::string* output, bool stoppable = false) {
   int pipe_fd[2];
   if (pipe2(pipe_fd, O_CLOEXEC) != 0) return -1;  // daemons must not inherit it
   std::vector<char*> args;

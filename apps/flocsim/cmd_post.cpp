@@ -132,7 +132,8 @@ int post(const std::string& what, const PostOptions& o) {
     const std::string no_figures = what == "tables" ? "" : pp::why_no_figures();
     if (!no_figures.empty()) {
       if (what == "figures") {
-        std::cerr << "flocsim post figures: no figures can be drawn: " << printable(no_figures) << "\n";
+        std::cerr << "flocsim post figures: no figures can be drawn: " << printable(no_figures)
+                  << "\n";
         return kExitFailure;
       }
       std::cerr << "flocsim post report: no figures: " << printable(no_figures)

@@ -61,8 +61,8 @@ int run_command(const RunArguments& a) {
                    "flocsim run: input error in %s: fluid.size: the populations take %.1f GiB, "
                    "more than 90 %% of the %.1f GiB free on the GPU (%s); use a smaller box, float "
                    "precision, or --device cpu\n",
-                   printable(a.case_file).c_str(), bytes / (1u << 30),
-                   q.devices.front().free_gib, printable(q.devices.front().name).c_str());
+                   printable(a.case_file).c_str(), bytes / (1u << 30), q.devices.front().free_gib,
+                   printable(q.devices.front().name).c_str());
       return kExitBadInput;
     }
   }

@@ -90,8 +90,8 @@ void check_worker(const std::string& given) {
     throw flocsim::input::InputError(option + worker +
                                      ": is a directory; give the worker program's path");
   if (access(found.c_str(), X_OK) != 0)
-    throw flocsim::input::InputError(option + worker + ": cannot be run (" +
-                                     std::strerror(errno) + "); allowed: an executable file");
+    throw flocsim::input::InputError(option + worker + ": cannot be run (" + std::strerror(errno) +
+                                     "); allowed: an executable file");
 }
 
 int exit_code_for(db::ResultsDb& db, const db::SweepRecord& sweep, bool stopped) {

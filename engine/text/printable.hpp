@@ -42,8 +42,8 @@ inline Utf8Char decode_utf8(std::string_view s, std::size_t i) {
     return {cp, 3};
   }
   if (b >= 0xF0 && b <= 0xF4 && cont(1) && cont(2) && cont(3)) {
-    const std::uint32_t cp = ((b & 0x07u) << 18) | ((at(1) & 0x3Fu) << 12) |
-                             ((at(2) & 0x3Fu) << 6) | (at(3) & 0x3Fu);
+    const std::uint32_t cp =
+        ((b & 0x07u) << 18) | ((at(1) & 0x3Fu) << 12) | ((at(2) & 0x3Fu) << 6) | (at(3) & 0x3Fu);
     if (cp < 0x10000 || cp > 0x10FFFF) return {};
     return {cp, 4};
   }
@@ -75,8 +75,12 @@ inline std::string printable(std::string_view text) {
       out += {'\\', 'x', hex[c.code_point >> 4], hex[c.code_point & 15]};
       i += 1;
     } else if (is_terminal_control(c.code_point)) {
-      out += {'\\', 'u', hex[(c.code_point >> 12) & 15], hex[(c.code_point >> 8) & 15],
-              hex[(c.code_point >> 4) & 15], hex[c.code_point & 15]};
+      out += {'\\',
+              'u',
+              hex[(c.code_point >> 12) & 15],
+              hex[(c.code_point >> 8) & 15],
+              hex[(c.code_point >> 4) & 15],
+              hex[c.code_point & 15]};
       i += c.length;
     } else {
       out.append(text.substr(i, c.length));
@@ -108,8 +112,12 @@ inline std::string printable_json(std::string_view json_text) {
     const Utf8Char c = decode_utf8(json_text, i);
     const std::size_t n = c.length == 0 ? 1 : c.length;
     if (c.length != 0 && c.code_point >= 0x20 && is_terminal_control(c.code_point))
-      out += {'\\', 'u', hex[(c.code_point >> 12) & 15], hex[(c.code_point >> 8) & 15],
-              hex[(c.code_point >> 4) & 15], hex[c.code_point & 15]};
+      out += {'\\',
+              'u',
+              hex[(c.code_point >> 12) & 15],
+              hex[(c.code_point >> 8) & 15],
+              hex[(c.code_point >> 4) & 15],
+              hex[c.code_point & 15]};
     else
       out.append(json_text.substr(i, n));
     i += n;

@@ -4,6 +4,7 @@
 // database is then read back directly.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,8 +15,6 @@
 #include <set>
 #include <sstream>
 #include <tuple>
-
-#include <sqlite3.h>
 
 #include "db/results_db.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
@@ -404,13 +403,14 @@ TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
 // saying to move the file; once it is moved, the next resume runs the case.
 TEST_F(Orchestrator, AnotherCasesResultInARunFolderFailsTheAttemptUntilMoved) {
   const auto tiny = [](double viscosity) {
-    return json{{"scene", "fluid"},
-                {"fluid",
-                 {{"size", {16, 4, 4}},
-                  {"viscosity", viscosity},
-                  {"initial",
-                   {{"type", "shear_wave"}, {"amplitude", 0.01}, {"axis", "x"}, {"component", "y"}}}}},
-                {"run", {{"steps", 20}, {"threads", 1}}}};
+    return json{
+        {"scene", "fluid"},
+        {"fluid",
+         {{"size", {16, 4, 4}},
+          {"viscosity", viscosity},
+          {"initial",
+           {{"type", "shear_wave"}, {"amplitude", 0.01}, {"axis", "x"}, {"component", "y"}}}}},
+        {"run", {{"steps", 20}, {"threads", 1}}}};
   };
   t::write_text(dir_ / "other.json", tiny(0.02).dump());
   ASSERT_EQ(t::run(flocsim({"run", (dir_ / "other.json").string(), "--out",
@@ -419,8 +419,8 @@ TEST_F(Orchestrator, AnotherCasesResultInARunFolderFailsTheAttemptUntilMoved) {
             0);
   t::write_text(dir_ / "s.json",
                 json{{"name", "s"}, {"base", tiny(0.04)}, {"axes", {{"run.steps", {20}}}}}.dump());
-  EXPECT_EQ(t::run(flocsim({"sweep", "launch", (dir_ / "s.json").string(), "--db", db_,
-                            "--worker", "/bin/false"}))
+  EXPECT_EQ(t::run(flocsim({"sweep", "launch", (dir_ / "s.json").string(), "--db", db_, "--worker",
+                            "/bin/false"}))
                 .code,
             1);
   const fs::path folder = ResultsDb(db_, ResultsDb::Mode::kExisting).runs().front().run_dir;
@@ -576,12 +576,14 @@ TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
     exec("UPDATE sweeps SET name = ?1", hostile);
     // a point that is JSON (its value holds ESC and U+202E as JSON escapes)
     // for the failed run, one that is not for the completed run
-    exec("UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
-         "(SELECT id FROM runs WHERE status = 'failed')",
-         R"({"x":"v\u001b[31m\u202e"})");
-    exec("UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
-         "(SELECT id FROM runs WHERE status = 'completed')",
-         "{\"x\":\"\xff\"}");
+    exec(
+        "UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+        "(SELECT id FROM runs WHERE status = 'failed')",
+        R"({"x":"v\u001b[31m\u202e"})");
+    exec(
+        "UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+        "(SELECT id FROM runs WHERE status = 'completed')",
+        "{\"x\":\"\xff\"}");
     exec("UPDATE runs SET error = ?1 WHERE status = 'failed'", "boom\x1b]0;title\x07 \xe2\x80\xae");
     sqlite3_close(db);
   }
@@ -606,8 +608,8 @@ TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
   EXPECT_NE(j.out.find(R"("error": "boom\u001b]0;title\u0007 \u202e")"), std::string::npos)
       << j.out;
 
-  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_, "--sweep", hostile,
-                                      "--worker", FAKE_WORKER_EXE}));
+  const t::Output r = t::run(
+      flocsim({"sweep", "resume", "--db", db_, "--sweep", hostile, "--worker", FAKE_WORKER_EXE}));
   EXPECT_EQ(r.code, 1) << r.out;  // x = 2 fails again
   EXPECT_EQ(raw_bytes_in(r.out), "") << r.out;
   EXPECT_NE(r.out.find("x=v\\x1b[31m\\u202e"), std::string::npos) << r.out;  // started ...
@@ -694,8 +696,7 @@ TEST_F(Orchestrator, SbatchWithoutAJobIdOrAnswerAndAMissingEnvWorkerAreSaid) {
   const t::Output e =
       t::run(flocsim({"sweep", "resume", "--db", db_}), {"FLOCSIM_WORKER=" + missing});
   EXPECT_EQ(e.code, 2) << e.out;
-  EXPECT_NE(e.out.find("FLOCSIM_WORKER=" + missing + ": no such file"), std::string::npos)
-      << e.out;
+  EXPECT_NE(e.out.find("FLOCSIM_WORKER=" + missing + ": no such file"), std::string::npos) << e.out;
   ResultsDb db(db_, ResultsDb::Mode::kExisting);
   EXPECT_EQ(db.runs().front().attempts, 0);
 }

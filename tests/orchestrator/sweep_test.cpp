@@ -66,15 +66,17 @@ TEST(Printable, ControlsAndBidiAreEscapedAndOtherUtf8IsKept) {
   EXPECT_EQ(printable("\xe2\x80\xaa\xe2\x80\xab\xe2\x80\xac\xe2\x80\xad"),
             "\\u202a\\u202b\\u202c\\u202d");
   EXPECT_EQ(printable("\xe2\x81\xa6x\xe2\x81\xa9"), "\\u2066x\\u2069");  // LRI, PDI
-  EXPECT_EQ(printable("\xe2\x80\x8f\xd8\x9c"), "\\u200f\\u061c");         // RLM, ALM
-  EXPECT_EQ(printable("l\xe2\x80\xa8p"), "l\\u2028p");                    // line separator
-  EXPECT_EQ(printable("csi\xc2\x9b" "31m \xc2\x85"), "csi\\u009b31m \\u0085");  // C1
+  EXPECT_EQ(printable("\xe2\x80\x8f\xd8\x9c"), "\\u200f\\u061c");        // RLM, ALM
+  EXPECT_EQ(printable("l\xe2\x80\xa8p"), "l\\u2028p");                   // line separator
+  EXPECT_EQ(printable("csi\xc2\x9b"
+                      "31m \xc2\x85"),
+            "csi\\u009b31m \\u0085");  // C1
   // not UTF-8: each byte as it is
   EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");
   EXPECT_EQ(printable("lone\x80"), "lone\\x80");
   EXPECT_EQ(printable("cut\xe2\x80"), "cut\\xe2\\x80");
-  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");                  // overlong "/"
-  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");         // a surrogate
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");                    // overlong "/"
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");           // a surrogate
   EXPECT_EQ(printable("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");  // above U+10FFFF
   EXPECT_EQ(printable("\xe2\x80\xaeZ\xe2"), "\\u202eZ\\xe2");
   // only printable ASCII is added: escaping twice changes nothing more
@@ -101,11 +103,11 @@ TEST(ShellWord, ControlBidiAndNonUtf8WordsAreAnsiCQuoted) {
   EXPECT_EQ(orc::shell_word("\xff Å"), "$'\\xff Å'");
   if (access("/bin/bash", X_OK) != 0) GTEST_SKIP() << "no /bin/bash to paste into";
   for (const std::string& word : {std::string("a\x1b[31mb"), std::string("it's\n"),
-                                 std::string("x\xe2\x80\xae\\y"), std::string("\xff Å $(id)")}) {
+                                  std::string("x\xe2\x80\xae\\y"), std::string("\xff Å $(id)")}) {
     const std::string file = testing::TempDir() + "shell_word_" + std::to_string(getpid());
     // the command line goes through sh first: quoted once more for it
-    const std::string sh = "/bin/bash -c " + orc::shell_word("printf %s " + orc::shell_word(word) +
-                                                      " > " + file);
+    const std::string sh =
+        "/bin/bash -c " + orc::shell_word("printf %s " + orc::shell_word(word) + " > " + file);
     ASSERT_EQ(std::system(sh.c_str()), 0) << sh;
     std::ifstream in(file, std::ios::binary);
     const std::string back((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
