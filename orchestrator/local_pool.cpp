@@ -20,6 +20,7 @@
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/output_directory.hpp"
 #include "orchestrator/process.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -114,7 +115,7 @@ std::string short_id(const std::string& id) {
 }
 
 void say(std::ostream* out, const std::string& line) {
-  if (out) *out << line << std::endl;
+  if (out) *out << printable(line) << std::endl;  // names a run folder, a host, a reason
 }
 
 // DIR/result.json read as this run's result: complete, and of this run's case.
@@ -142,19 +143,16 @@ ResultRead read_own_result(const db::RunRecord& run) {
           run.run_dir + "/result.json is the result of another case (" +
               (field.empty() ? std::string("it records no case")
                              : "first difference at case field " + field) +
-              "); it is not this run's result, so it is not recorded and is left as it is"};
+              "); it is not this run's result, so it is not recorded and is left as it is",
+          true};
 }
 
-// Records a result found complete on disk; returns whether it was valid.
-bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::RunRecord& run,
-                        std::ostream* out = nullptr) {
+// Records a result found complete on disk; returns whether it was valid (a
+// worker found gone may have left one of another case: not recorded, and the
+// attempt ends lost; the pool's claim says what to do about such a file).
+bool record_if_complete(db::ResultsDb& db, std::int64_t attempt_id, const db::RunRecord& run) {
   ResultRead rr = read_own_result(run);
-  if (!rr.record) {
-    // not an error yet (the worker may replace it), but never silent
-    if (out && rr.problem.find("another case") != std::string::npos)
-      *out << "not recorded " << run.id.substr(0, 12) << ": " << rr.problem << std::endl;
-    return false;
-  }
+  if (!rr.record) return false;
   db.record_result(attempt_id, *rr.record);
   return true;
 }
@@ -313,11 +311,27 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
       tried.push_back(run.id);
       fs::create_directories(run.run_dir);
       // A complete result already on disk (its recording was cut short): record, don't rerun.
-      if (record_if_complete(db, claim->attempt_id, run, o.out)) {
+      const ResultRead found = read_own_result(run);
+      if (found.record) {
+        db.record_result(claim->attempt_id, *found.record);
         ++sum.recovered;
         say(o.out, progress_tag() + " recorded " + short_id(run.id) + " " +
                        point_text(run.point_json) + " (result.json found complete on disk)");
         continue;
+      }
+      // Another case's result.json in the run folder: `flocsim run` refuses
+      // to run over it (exit 2), which made the run `refused` for good, with
+      // a hint (another --out) a sweep cannot follow. The attempt fails
+      // instead, saying what to move; the next resume retries the run.
+      if (found.foreign) {
+        const std::string why = found.problem +
+                                "; no worker was started: move it out of the run folder, then " +
+                                "resume the sweep";
+        db.end_attempt(claim->attempt_id, RunState::kFailed, std::nullopt, std::nullopt, why);
+        ++sum.failed;
+        say(o.out, progress_tag() + " failed   " + short_id(run.id) + " " +
+                       point_text(run.point_json) + ": " + why);
+        return true;
       }
       const bool resume = run.status != RunState::kPending;
       try {

@@ -12,6 +12,7 @@
 #include "engine/case/case_support.hpp"
 #include "engine/input/input_reader.hpp"
 #include "orchestrator/report.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -273,7 +274,7 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
     if (o.measure_steps > 0) {
       if (o.progress)
         *o.progress << "measuring configuration " << i + 1 << " of " << plan.costs.size() << " ("
-                    << c.description << ")\n"
+                    << printable(c.description) << ")\n"
                     << std::flush;
       c.measured = run::measure_steps(first_case[i], o.measure_steps, o.measure_seconds);
       plan.memory_per_run_max = std::max(plan.memory_per_run_max, c.measured->memory_bytes);
@@ -387,7 +388,7 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
 }
 
 void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
-  out << "plan of sweep " << p.sweep << ": " << p.runs.size() << " points, " << p.to_run
+  out << "plan of sweep " << printable(p.sweep) << ": " << p.runs.size() << " points, " << p.to_run
       << " to run";
   if (p.complete > 0) out << ", " << p.complete << " already complete in the database";
   out << ", " << p.refused << " refused\n";
@@ -443,7 +444,7 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
       const auto& [message, points] = by_message[i];
       out << "  " << points.front();
       if (points.size() > 1) out << " and " << points.size() - 1 << " more";
-      out << ": " << message << "\n";
+      out << ": " << printable(message) << "\n";
       if (every_run)
         for (std::size_t k = 1; k < points.size(); ++k) out << "    also " << points[k] << "\n";
     }
@@ -457,7 +458,7 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
   for (const StepCost& c : p.costs) {
     ++index;
     if (c.runs == 0) continue;
-    out << "  " << index << ". " << c.description << ": " << c.runs << " run"
+    out << "  " << index << ". " << printable(c.description) << ": " << c.runs << " run"
         << (c.runs == 1 ? "" : "s");
     if (c.measured) out << ", " << bytes_text(c.measured->memory_bytes) << " of memory each";
     out << "\n     " << c.basis() << "\n";
@@ -500,7 +501,7 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
              "--measure-steps N, or give --db with completed runs)\n";
     }
   }
-  for (const std::string& n : p.notes) out << "note: " << n << "\n";
+  for (const std::string& n : p.notes) out << "note: " << printable(n) << "\n";
 }
 
 }  // namespace flocsim::orchestrator

@@ -166,7 +166,8 @@ ResultRead read_result(const std::string& run_dir, const std::string& run_id) {
   try {
     r = nlohmann::json::parse(text.str());
   } catch (const nlohmann::json::parse_error& e) {
-    return {std::nullopt, file + " is not valid JSON (truncated?): " + e.what()};
+    return {std::nullopt, file + " is not valid JSON (truncated? bad syntax at byte " +
+                              std::to_string(e.byte) + ")"};
   }
   if (!r.is_object()) return {std::nullopt, file + " does not hold a JSON object"};
   if (r.value("status", nlohmann::json()) != "completed")

@@ -47,6 +47,7 @@ RunStage read_run_stage(const std::string& run_dir);
 struct ResultRead {
   std::optional<db::ResultRecord> record;
   std::string problem;
+  bool foreign = false;  // complete, but the result of another case
 };
 ResultRead read_result(const std::string& run_dir, const std::string& run_id);
 

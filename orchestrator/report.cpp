@@ -79,7 +79,7 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
   RunSelection selection = select_runs(db, o.sweep, o.where);
   if (o.left_out)
     for (const DamagedRun& d : selection.damaged)
-      *o.left_out << "left out, unreadable: " << d.text() << "\n";
+      *o.left_out << "left out, unreadable: " << printable(d.text()) << "\n";
   Table t{selection.columns, selection.axes, {}};
   std::vector<json> cases;
   for (RunView& r : selection.runs) {
@@ -129,16 +129,32 @@ int write_query(db::ResultsDb& db, const QueryOptions& o, std::ostream& out) {
       if (!t.rows[i]["error"].get<std::string>().empty()) row["error"] = t.rows[i]["error"];
       arr.push_back(row);
     }
-    out << arr.dump(2) << "\n";
+    std::string text;
+    try {
+      text = arr.dump(2);
+    } catch (const json::type_error&) {
+      // JSON holds only UTF-8: said, not silent
+      text = arr.dump(2, ' ', false, json::error_handler_t::replace);
+      if (o.left_out)
+        *o.left_out << "bytes that are not UTF-8 in the database are written as U+FFFD\n";
+    }
+    // C1 and bidirectional controls as JSON's own \uXXXX escapes: the same
+    // document, and a terminal shows them rather than obeying them
+    out << text::printable_json(text) << "\n";
     return static_cast<int>(keep.size());
   }
   if (o.format == "csv") {
-    for (std::size_t c = 0; c < cols.size(); ++c) out << (c ? "," : "") << csv_field(cols[c]);
+    // as the table shows them (printable): CSV has no escapes of its own for
+    // ESC or U+202E, and this may be read on a terminal; --format json keeps
+    // every character
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      out << (c ? "," : "") << csv_field(printable(cols[c]));
     out << "\n";
     for (std::size_t i : keep) {
       for (std::size_t c = 0; c < cols.size(); ++c) {
         auto it = t.rows[i].find(cols[c]);
-        out << (c ? "," : "") << csv_field(it == t.rows[i].end() ? "" : value_text(it->second));
+        out << (c ? "," : "")
+            << csv_field(it == t.rows[i].end() ? "" : printable(value_text(it->second)));
       }
       out << "\n";
     }
@@ -254,7 +270,7 @@ void write_columns(const std::vector<std::vector<std::string>>& given, const std
   // as a terminal should show them: errors and points carry text from files
   std::vector<std::vector<std::string>> rows = given;
   for (auto& row : rows)
-    for (std::string& cell : row) cell = terminal_text(cell);
+    for (std::string& cell : row) cell = printable(cell);
   auto width = [](const std::string& s) {
     std::size_t w = 0;
     for (unsigned char ch : s) w += (ch & 0xC0) != 0x80;
@@ -294,7 +310,7 @@ bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
   } else {
     sweeps = db.sweeps();
   }
-  if (sweeps.empty()) out << "no sweeps in " << db.path() << "\n";
+  if (sweeps.empty()) out << "no sweeps in " << printable(db.path()) << "\n";
   const double now = db::unix_now();
   std::map<std::string, db::AttemptRecord> live;
   for (db::AttemptRecord& a : db.live_attempts()) live[a.run_id] = a;
@@ -308,7 +324,7 @@ bool write_status(db::ResultsDb& db, const std::optional<std::string>& sweep_nam
         if (a.state == RunState::kLost) was_lost = true, ++lost_attempts;
       if (was_lost && r.status == RunState::kCompleted) ++recovered;
     }
-    out << "sweep " << terminal_text(s.name) << ": " << runs.size() << " runs:";
+    out << "sweep " << printable(s.name) << ": " << runs.size() << " runs:";
     int lost_now = 0;
     for (const db::StateCount& c : db.count_states(s.id)) {
       if (c.status == RunState::kLost) lost_now = c.runs;

@@ -1,11 +1,13 @@
 #include "orchestrator/slurm_backend.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -22,6 +24,7 @@
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/process.hpp"
 #include "orchestrator/sweep.hpp"
+#include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -31,8 +34,10 @@ using db::RunState;
 namespace {
 
 // Runs a program (looked up in PATH), capturing stdout and stderr; returns its
-// exit code, or -1 when it could not be run.
-int run_program(const std::vector<std::string>& argv, std::string* output) {
+// exit code, or -1 when it could not be run. A `stoppable` one is ended
+// (SIGTERM, then SIGKILL) when flocsim is asked to stop: an sbatch that never
+// answers otherwise held flocsim in read() through every Ctrl-C and SIGTERM.
+int run_program(const std::vector<std::string>& argv, std::string* output, bool stoppable = false) {
   int pipe_fd[2];
   if (pipe2(pipe_fd, O_CLOEXEC) != 0) return -1;  // daemons must not inherit it
   std::vector<char*> args;
@@ -52,7 +57,39 @@ int run_program(const std::vector<std::string>& argv, std::string* output) {
   std::string text;
   char buf[4096];
   ssize_t n;
-  while ((n = read(pipe_fd[0], buf, sizeof buf)) > 0) text.append(buf, static_cast<std::size_t>(n));
+  int stop_sent = 0;
+  while (true) {
+    if (stoppable) {
+      if (process::stop_requests() > 0 && stop_sent == 0) {
+        kill(pid, SIGTERM);
+        stop_sent = 1;
+        text += "(stopped: flocsim was asked to stop while " + argv.front() + " ran) ";
+      }
+      pollfd p{pipe_fd[0], POLLIN, 0};
+      const int ready = poll(&p, 1, stop_sent > 0 ? 2000 : 200);
+      if (ready < 0) continue;  // a signal: look at the stop request again
+      if (ready == 0) {
+        if (stop_sent == 1) {  // still there two seconds after SIGTERM
+          kill(pid, SIGKILL);
+          stop_sent = 2;
+        }
+        if (stop_sent == 2) {
+          // a grandchild may hold the pipe open: flocsim does not wait for it
+          pid_t done = waitpid(pid, nullptr, WNOHANG);
+          if (done == pid) {
+            close(pipe_fd[0]);
+            if (output) *output = text;
+            return -1;
+          }
+        }
+        continue;
+      }
+    }
+    n = read(pipe_fd[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+  }
   close(pipe_fd[0]);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -69,7 +106,7 @@ std::string shell_quote(const std::string& s) {
 }
 
 void say(std::ostream* out, const std::string& line) {
-  if (out) *out << line << std::endl;
+  if (out) *out << printable(line) << std::endl;  // names a job, a path, Slurm's reason
 }
 
 // Where execvp would find `program` ("" when nowhere): run_program's -1 says
@@ -177,10 +214,16 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
     settings = parse_sweep(nlohmann::ordered_json::parse(sweep.spec_json),
                            db.path() + " (sweep " + sweep.name + " as stored)")
                    .slurm;
-  } catch (const nlohmann::json::exception& e) {
+  } catch (const nlohmann::json::parse_error& e) {
+    // said in words: the library's own "[json.exception.parse_error.101]" is
+    // no help to a user
     throw flocsim::input::InputError(db.path() + ": the stored file of sweep " + sweep.name +
-                                     " is not JSON (" + e.what() +
+                                     " is not JSON (bad syntax at byte " + std::to_string(e.byte) +
                                      "); launch its sweep file again");
+  } catch (const nlohmann::json::exception&) {
+    throw flocsim::input::InputError(db.path() + ": the stored file of sweep " + sweep.name +
+                                     " cannot be read as a sweep file; launch its sweep file "
+                                     "again");
   }
   const int per_task = settings.runs_per_task;
   const int max_parallel = settings.max_parallel;
@@ -254,12 +297,20 @@ SlurmSummary run_slurm(db::ResultsDb& db, const db::SweepRecord& sweep, const Sl
       << " --worker " << shell_quote(l.worker) << " --lease " << l.lease_s << "\n";
   }
   std::string text;
-  const int rc = run_program(argv, &text);
+  const int rc = run_program(argv, &text, true);
   if (rc != 0)
     throw std::runtime_error(rc < 0 ? "sbatch (" + on_path("sbatch") + ") could not be run: " + text
                                     : "sbatch refused the job (exit " + std::to_string(rc) +
                                           "): " + text);
   sum.job_id = text.substr(0, text.find_first_of(";\n"));
+  // sbatch --parsable answers "JOBID" or "JOBID;CLUSTER": anything else is not
+  // a job flocsim can follow (or scancel), so it is not said to be submitted
+  if (sum.job_id.empty() || sum.job_id.size() > 18 ||
+      sum.job_id.find_first_not_of("0123456789") != std::string::npos)
+    throw std::runtime_error("sbatch (" + on_path("sbatch") + ") answered \"" +
+                             text.substr(0, 200) +
+                             "\" where --parsable gives the job id; flocsim cannot follow that "
+                             "job: see squeue whether one was queued, and scancel it");
   sum.tasks = tasks;
   sum.runs = static_cast<int>(to_submit.size());
   say(l.out, "slurm: submitted job " + sum.job_id + ": " + std::to_string(to_submit.size()) +
@@ -366,7 +417,7 @@ int cancel_all(db::ResultsDb& db, std::ostream& out) {
   for (const std::string& j : jobs) {
     std::string text;
     const int rc = run_program({"scancel", j}, &text);
-    out << "scancel " << j << (rc == 0 ? "" : ": failed: " + text) << "\n";
+    out << "scancel " << printable(j) << (rc == 0 ? "" : ": failed: " + printable(text)) << "\n";
   }
   if (owners.empty() && jobs.empty()) out << "nothing is running\n";
   return static_cast<int>(owners.size() + jobs.size());

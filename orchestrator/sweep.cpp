@@ -334,12 +334,12 @@ std::vector<RunPoint> expand(const SweepSpec& sweep) {
 std::string point_text(const std::string& point_json) {
   if (point_json.empty()) return "";
   const auto p = nlohmann::ordered_json::parse(point_json, nullptr, false);
-  if (!p.is_object()) return terminal_text(point_json);
+  if (!p.is_object()) return printable(point_json);
   std::string out;
   for (auto it = p.begin(); it != p.end(); ++it)
     out += (out.empty() ? "" : " ") + it.key() + "=" +
            (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
-  return terminal_text(out);  // for terminals: a value's ESC or U+202E is shown, not obeyed
+  return printable(out);  // for terminals: a value's ESC or U+202E is shown, not obeyed
 }
 
 std::string shell_word(const std::string& word) {
@@ -347,6 +347,28 @@ std::string shell_word(const std::string& word) {
                                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
                                           "0123456789-_./:,+=@") == std::string::npos;
   if (plain) return word;
+  if (!text::is_printable(word)) {
+    // bash's $'...': every byte a terminal would obey (or that is not UTF-8)
+    // as \xNN, so the line shows what it is and pastes back the same bytes
+    static constexpr char hex[] = "0123456789abcdef";
+    std::string out = "$'";
+    for (std::size_t i = 0; i < word.size();) {
+      const text::Utf8Char c = text::decode_utf8(word, i);
+      const std::size_t n = c.length == 0 ? 1 : c.length;
+      if (c.length == 0 || text::is_terminal_control(c.code_point)) {
+        for (std::size_t k = 0; k < n; ++k) {
+          const auto b = static_cast<unsigned char>(word[i + k]);
+          out += {'\\', 'x', hex[b >> 4], hex[b & 15]};
+        }
+      } else if (word[i] == '\\' || word[i] == '\'') {
+        out += {'\\', word[i]};
+      } else {
+        out.append(word, i, n);
+      }
+      i += n;
+    }
+    return out + "'";
+  }
   std::string out = "'";
   for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";

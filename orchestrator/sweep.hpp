@@ -86,7 +86,10 @@ std::string point_text(const std::string& point_json);
 // `word` as one word of a POSIX shell command a user may paste (the commands
 // flocsim suggests): as it is when it holds only letters, digits and
 // - _ . / : , + = @, single-quoted otherwise, so that no name or path runs as
-// a command ("$(touch X)" stays text).
+// a command ("$(touch X)" stays text). A word holding characters a terminal
+// obeys (ESC, U+202E, a newline; text::printable) or bytes that are not UTF-8
+// is written as $'...' with those bytes as \xNN: shown as what it is, and the
+// same bytes when pasted into bash, zsh or ksh.
 std::string shell_word(const std::string& word);
 
 }  // namespace flocsim::orchestrator

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "engine/text/printable.hpp"
+
 namespace flocsim::orchestrator {
 
 std::size_t display_width(const std::string& s) {
@@ -27,47 +29,14 @@ std::size_t terminal_width(int out_fd) {
   return 0;
 }
 
-std::string terminal_text(const std::string& text) {
-  std::string out;
-  char buf[16];
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const auto b = static_cast<unsigned char>(text[i]);
-    const auto next = [&](std::size_t k) {
-      return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0;
-    };
-    if (b < 0x20 || b == 0x7f) {
-      std::snprintf(buf, sizeof buf, "\\x%02x", b);
-      out += buf;
-    } else if (b == 0xC2 && next(1) >= 0x80 && next(1) <= 0x9F) {  // C1 controls
-      std::snprintf(buf, sizeof buf, "\\u%04x", next(1));
-      out += buf;
-      i += 1;
-    } else if (b == 0xD8 && next(1) == 0x9C) {  // U+061C arabic letter mark
-      out += "\\u061c";
-      i += 1;
-    } else if (b == 0xE2 && ((next(1) == 0x80 && (next(2) == 0x8E || next(2) == 0x8F ||
-                                                  (next(2) >= 0xAA && next(2) <= 0xAE))) ||
-                             (next(1) == 0x81 && next(2) >= 0xA6 && next(2) <= 0xA9))) {
-      // U+200E/F, U+202A-202E, U+2066-2069
-      const unsigned cp = 0x2000u + ((next(1) & 0x3Fu) << 6) + (next(2) & 0x3Fu);
-      std::snprintf(buf, sizeof buf, "\\u%04x", cp);
-      out += buf;
-      i += 2;
-    } else {
-      out += text[i];
-    }
-  }
-  return out;
-}
-
 std::vector<std::string> write_fitted(const std::vector<TerminalColumn>& given, std::size_t width,
                                       std::ostream& out) {
   // every header and cell as the terminal should show it (names and values
   // come from sweep files and databases)
   std::vector<TerminalColumn> columns = given;
   for (TerminalColumn& c : columns) {
-    c.header = terminal_text(c.header);
-    for (std::string& cell : c.cells) cell = terminal_text(cell);
+    c.header = text::printable(c.header);
+    for (std::string& cell : c.cells) cell = text::printable(cell);
   }
   std::vector<std::size_t> w(columns.size(), 0);
   for (std::size_t c = 0; c < columns.size(); ++c) {

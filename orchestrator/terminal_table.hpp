@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/text/printable.hpp"
+
 namespace flocsim::orchestrator {
 
 struct TerminalColumn {
@@ -24,12 +26,9 @@ std::vector<std::string> write_fitted(const std::vector<TerminalColumn>& columns
 // set, else 0 (no limit: a pipe or file gets every column it asked for).
 std::size_t terminal_width(int out_fd = 1);
 
-// `text` safe to print on a terminal: control characters (C0, DEL, C1: ESC
-// sequences recolour, move or retitle the terminal) and the bidirectional
-// controls (U+202E and its kin reorder what follows) are written as \x1b or
-// \u202e, so that a name or value from a sweep file or database shows as what
-// it is. Everything else, other UTF-8 included, is kept.
-std::string terminal_text(const std::string& text);
+// Every name and value printed for a terminal goes through text::printable
+// (engine/text/printable.hpp): control and bidirectional characters escaped.
+using text::printable;
 
 // Characters a UTF-8 string takes on a terminal (one per code point).
 std::size_t display_width(const std::string& s);

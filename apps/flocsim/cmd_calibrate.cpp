@@ -93,7 +93,7 @@ int run_pair_calibration(const CalibrateOptions& o) {
     // under the table's lock, with what other calibrations added meanwhile
     calibration::add_to_table_file(o.table, e, note);
   }
-  std::printf("table written to %s\n", o.table.c_str());
+  std::printf("table written to %s\n", printable(o.table).c_str());
   return kExitOk;
 }
 
@@ -164,7 +164,7 @@ int run_radius_calibration(const CalibrateOptions& o) {
     // table's lock, with what other calibrations added meanwhile
     calibration::add_to_table_file(o.table, entry, note);
   }
-  std::printf("table written to %s\n", o.table.c_str());
+  std::printf("table written to %s\n", printable(o.table).c_str());
   return kExitOk;
 }
 
@@ -247,7 +247,7 @@ int run_calibrate(const CalibrateOptions& o, const CLI::App& cmd) {
   try {
     check_before_work(o, cmd);
   } catch (const input::InputError& e) {
-    std::cerr << "flocsim calibrate: " << e.what() << "\n";
+    std::cerr << "flocsim calibrate: " << printable(e.what()) << "\n";
     return kExitBadInput;
   }
   return o.close_pairs ? run_pair_calibration(o) : run_radius_calibration(o);

@@ -102,19 +102,19 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const std::vector<std
   for (const std::string& l : left_out) text += "- " + l + "\n";
   write_file(out / "left_out.md", text);
   std::cout << "Aggregation: F/F0 against <n_a>/<n_a>0 (" << agg.size()
-            << " runs with du > 0; every column in " << (out / "aggregation.md").string()
+            << " runs with du > 0; every column in " << printable((out / "aggregation.md").string())
             << ")\n\n";
   pp::write_aggregation_terminal(agg, o.columns, o.all,
                                  o.all || !o.columns.empty() ? 0 : orchestrator::terminal_width(),
                                  std::cout);
   std::cout << "\nNon-aggregating runs against Beetstra, Wylie and "
             << "Richardson-Zaki: " << non.size() << " rows in "
-            << (out / "non_aggregating.md").string()
+            << printable((out / "non_aggregating.md").string())
             << "\nTables (CSV, Markdown, LaTeX) and their column definitions (columns.md) in "
-            << out.string() << "\n";
+            << printable(out.string()) << "\n";
   if (!left_out.empty())
     std::cout << left_out.size() << " unreadable row" << (left_out.size() > 1 ? "s" : "")
-              << " left out of the tables: " << (out / "left_out.md").string() << "\n";
+              << " left out of the tables: " << printable((out / "left_out.md").string()) << "\n";
 }
 
 int post(const std::string& what, const PostOptions& o) {
@@ -132,10 +132,11 @@ int post(const std::string& what, const PostOptions& o) {
     const std::string no_figures = what == "tables" ? "" : pp::why_no_figures();
     if (!no_figures.empty()) {
       if (what == "figures") {
-        std::cerr << "flocsim post figures: no figures can be drawn: " << no_figures << "\n";
+        std::cerr << "flocsim post figures: no figures can be drawn: " << printable(no_figures)
+                  << "\n";
         return kExitFailure;
       }
-      std::cerr << "flocsim post report: no figures: " << no_figures
+      std::cerr << "flocsim post report: no figures: " << printable(no_figures)
                 << "; the tables and a report without figures are written\n";
     }
     db::ResultsDb db(o.db_path, db::ResultsDb::Mode::kReadOnly);
@@ -145,7 +146,7 @@ int post(const std::string& what, const PostOptions& o) {
     std::vector<std::string> left_out;
     for (const auto& d : damaged) {
       left_out.push_back(d.text());
-      std::cerr << "flocsim post: left out, unreadable: " << d.text() << "\n";
+      std::cerr << "flocsim post: left out, unreadable: " << printable(d.text()) << "\n";
     }
     const fs::path out(o.out_dir);
     fs::create_directories(out);
@@ -154,29 +155,29 @@ int post(const std::string& what, const PostOptions& o) {
     } else {
       const pp::FigureSet figures = pp::write_figures(runs, out / "figures");
       if (what == "figures")
-        for (const auto& f : figures.figures) std::cout << f.png.string() << "\n";
-      for (const auto& s : figures.skipped) std::cout << "not drawn: " << s << "\n";
+        for (const auto& f : figures.figures) std::cout << printable(f.png.string()) << "\n";
+      for (const auto& s : figures.skipped) std::cout << "not drawn: " << printable(s) << "\n";
       for (const auto& s : figures.runs_left_out)
-        std::cerr << "flocsim post: left out of figures: " << s << "\n";
+        std::cerr << "flocsim post: left out of figures: " << printable(s) << "\n";
       if (what == "report") {
         write_tables(runs, left_out, out, o);
         pp::write_report(runs, figures, o.db_path, out / "report.html", left_out);
       }
       std::cout << figures.figures.size() << " figures (PNG and PDF, with their data and gnuplot "
-                << "scripts) in " << (out / "figures").string() << "\n";
+                << "scripts) in " << printable((out / "figures").string()) << "\n";
       if (what == "report")
         std::cout << "Report (tables, figures, provenance; one file): "
-                  << (out / "report.html").string() << "\n";
+                  << printable((out / "report.html").string()) << "\n";
     }
     return kExitOk;
   } catch (const input::InputError& e) {
-    std::cerr << "flocsim post: " << e.what() << "\n";
+    std::cerr << "flocsim post: " << printable(e.what()) << "\n";
     return kExitBadInput;
   } catch (const db::DbError& e) {
-    std::cerr << "flocsim post: " << e.what() << "\n";
+    std::cerr << "flocsim post: " << printable(e.what()) << "\n";
     return kExitFailure;
   } catch (const std::exception& e) {
-    std::cerr << "flocsim post: " << e.what() << "\n";
+    std::cerr << "flocsim post: " << printable(e.what()) << "\n";
     return kExitFailure;
   }
 }

@@ -51,10 +51,10 @@ const bool registered = register_command(
            orc::write_query(db, q, std::cout);
            return kExitOk;
          } catch (const flocsim::input::InputError& e) {
-           std::cerr << "flocsim query: " << e.what() << "\n";
+           std::cerr << "flocsim query: " << printable(e.what()) << "\n";
            return kExitBadInput;
          } catch (const db::DbError& e) {
-           std::cerr << "flocsim query: " << e.what() << "\n";
+           std::cerr << "flocsim query: " << printable(e.what()) << "\n";
            return kExitFailure;
          }
        });

@@ -33,10 +33,11 @@ int run_command(const RunArguments& a) {
     parsed = cases::parse_case(document);
   } catch (const input::InputError& e) {
     // file-level refusals (read_json_file) already start with the file's name
-    const std::string what = e.what();
-    const bool named = what.rfind(a.case_file + ":", 0) == 0;
+    const std::string what = printable(e.what());
+    const std::string file = printable(a.case_file);
+    const bool named = what.rfind(file + ":", 0) == 0;
     std::fprintf(stderr, "flocsim run: input error%s%s: %s\n", named ? "" : " in ",
-                 named ? "" : a.case_file.c_str(), what.c_str());
+                 named ? "" : file.c_str(), what.c_str());
     return kExitBadInput;
   }
   // A GPU that is not there is found out now, before any output is written.
@@ -48,7 +49,7 @@ int run_command(const RunArguments& a) {
       std::fprintf(stderr,
                    "flocsim run: input error in %s: device = \"cuda\": %s; run on the CPU "
                    "with --device cpu\n",
-                   a.case_file.c_str(), q.why_none.c_str());
+                   printable(a.case_file).c_str(), printable(q.why_none).c_str());
       return kExitBadInput;
     }
     // the populations must fit the GPU's free memory (the host mirror is
@@ -67,8 +68,8 @@ int run_command(const RunArguments& a) {
                    "flocsim run: input error in %s: the lattice takes %.1f GiB on the GPU, "
                    "more than 90 %% of the %.1f GiB free there (%s); use a smaller box, float "
                    "precision, or --device cpu\n",
-                   a.case_file.c_str(), bytes / (1u << 30), q.devices.front().free_gib,
-                   q.devices.front().name.c_str());
+                   printable(a.case_file).c_str(), bytes / (1u << 30), q.devices.front().free_gib,
+                   printable(q.devices.front().name).c_str());
       return kExitBadInput;
     }
   }
@@ -83,7 +84,7 @@ int run_command(const RunArguments& a) {
     report = parsed.fluid_scene ? run::run_fluid_case(parsed.fluid, options)
                                 : run::run_sphere_case(parsed.spheres, options);
   } catch (const input::InputError& e) {
-    std::fprintf(stderr, "flocsim run: input error: %s\n", e.what());
+    std::fprintf(stderr, "flocsim run: input error: %s\n", printable(e.what()).c_str());
     return kExitBadInput;
   }
   switch (report.outcome) {
@@ -92,7 +93,7 @@ int run_command(const RunArguments& a) {
     case run::RunOutcome::interrupted:
       return kExitInterrupted;
     case run::RunOutcome::failed:
-      std::fprintf(stderr, "flocsim run: failed: %s\n", report.message.c_str());
+      std::fprintf(stderr, "flocsim run: failed: %s\n", printable(report.message).c_str());
       return kExitFailure;
   }
   return kExitFailure;

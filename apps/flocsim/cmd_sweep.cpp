@@ -58,11 +58,15 @@ std::string default_worker() {
       "cannot find the flocsim executable to run as the worker; give --worker PATH");
 }
 
-// Refuses a --worker that cannot be started, before any run is claimed: a
-// missing one failed every run with exit 127, naming no path, and each
-// failure used up one of the run's attempts.
-void check_worker(const std::string& worker) {
+// Refuses a --worker (or $FLOCSIM_WORKER) that cannot be started, before any
+// run is claimed: a missing one failed every run with exit 127, naming no
+// path, and each failure used up one of the run's attempts.
+void check_worker(const std::string& given) {
+  // the worker the runs would get: --worker, else $FLOCSIM_WORKER, else this flocsim
+  const char* env = std::getenv("FLOCSIM_WORKER");
+  const std::string worker = !given.empty() ? given : env && *env ? env : "";
   if (worker.empty()) return;  // this flocsim
+  const std::string option = !given.empty() ? "--worker " : "FLOCSIM_WORKER=";
   std::string found;
   if (worker.find('/') != std::string::npos) {
     found = worker;
@@ -74,22 +78,22 @@ void check_worker(const std::string& worker) {
       if (access(p.c_str(), X_OK) == 0 && !std::filesystem::is_directory(p)) found = p.string();
     }
     if (found.empty())
-      throw flocsim::input::InputError("--worker " + worker + ": not found on PATH (" +
+      throw flocsim::input::InputError(option + worker + ": not found on PATH (" +
                                        (path ? path : "unset") +
                                        "); give the worker program's path");
   }
   std::error_code ec;
   if (!std::filesystem::exists(found, ec))
-    throw flocsim::input::InputError("--worker " + worker + ": no such file" +
+    throw flocsim::input::InputError(option + worker + ": no such file" +
                                      (ec ? " (" + ec.message() + ")" : std::string()) +
                                      "; give the path of a program run as `WORKER run CASE "
                                      "--out DIR` (default: this flocsim)");
   if (std::filesystem::is_directory(found, ec))
-    throw flocsim::input::InputError("--worker " + worker +
+    throw flocsim::input::InputError(option + worker +
                                      ": is a directory; give the worker program's path");
   if (access(found.c_str(), X_OK) != 0)
-    throw flocsim::input::InputError("--worker " + worker + ": cannot be run (" +
-                                     std::strerror(errno) + "); allowed: an executable file");
+    throw flocsim::input::InputError(option + worker + ": cannot be run (" + std::strerror(errno) +
+                                     "); allowed: an executable file");
 }
 
 int exit_code_for(db::ResultsDb& db, const db::SweepRecord& sweep, bool stopped) {
@@ -349,10 +353,10 @@ const bool registered = register_command(
              const std::string runs_dir =
                  o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
              const orc::Registered reg = orc::register_sweep(db, spec, runs_dir);
-             std::cout << "sweep " << orc::terminal_text(spec.name) << ": " << reg.runs << " runs ("
+             std::cout << "sweep " << orc::printable(spec.name) << ": " << reg.runs << " runs ("
                        << reg.added.added << " new, " << reg.added.reused << " already in "
-                       << o->db_path << "); run folders under "
-                       << std::filesystem::absolute(runs_dir).string() << "\n";
+                       << orc::printable(o->db_path) << "); run folders under "
+                       << orc::printable(std::filesystem::absolute(runs_dir).string()) << "\n";
              return run_sweep(*o, db, reg.sweep,
                               {RunState::kPending, RunState::kInterrupted, RunState::kLost}, gpus);
            }
@@ -385,7 +389,7 @@ const bool registered = register_command(
              } catch (const db::ReadOnlyDbError& e) {
                writable = false;
                opened = std::make_unique<db::ResultsDb>(o->db_path, db::ResultsDb::Mode::kReadOnly);
-               std::cout << o->db_path
+               std::cout << orc::printable(o->db_path)
                          << (dynamic_cast<const db::DiskFullDbError*>(&e)
                                  ? ": the file system under it is full (free some space)"
                                  : " is read-only")
@@ -418,10 +422,10 @@ const bool registered = register_command(
              return orc::run_slurm_task(db, sweep, o->task_file, o->worker, o->lease_s, std::cout);
            }
          } catch (const flocsim::input::InputError& e) {
-           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitBadInput;
          } catch (const db::DbError& e) {
-           std::cerr << "flocsim sweep: " << e.what() << "\n";
+           std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitFailure;
          }
          return kExitBadInput;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/process/exit_codes.hpp"
+#include "engine/text/printable.hpp"
 
 namespace flocsim::app {
 
@@ -52,5 +53,11 @@ using process::kExitBadInput;
 using process::kExitFailure;
 using process::kExitInterrupted;
 using process::kExitOk;
+
+// Every message printed on stderr goes through text::printable: it carries
+// names, paths and values from files, databases and the command line, and
+// their control and bidirectional characters (and a newline, which would
+// forge a line) are shown escaped, never obeyed. One message is one line.
+using text::printable;
 
 }  // namespace flocsim::app

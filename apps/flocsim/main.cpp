@@ -35,6 +35,11 @@ int main(int argc, char** argv) {
                "(lattice Boltzmann D3Q19 + immersed boundary + event-driven contacts)"};
   app.set_version_flag("--version", FLOCSIM_VERSION);
   app.require_subcommand(1);
+  // CLI11's refusals quote the words given (an option's value, an unknown
+  // argument): shown escaped like every other message
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return printable(e.what()) + "\nRun with --help for more information.\n";
+  });
   std::vector<Command> sorted = commands();
   std::sort(sorted.begin(), sorted.end(),
             [](const Command& a, const Command& b) { return a.name < b.name; });
@@ -49,8 +54,8 @@ int main(int argc, char** argv) {
                    [&](const Command& c) { return c.name == argv[1]; })) {
     std::string known;
     for (const Command& c : sorted) known += (known.empty() ? "" : ", ") + c.name;
-    std::fprintf(stderr, "flocsim: %.80s: no such subcommand (subcommands: %s; see --help)\n",
-                 argv[1], known.c_str());
+    std::fprintf(stderr, "flocsim: %s: no such subcommand (subcommands: %s; see --help)\n",
+                 printable(std::string(argv[1]).substr(0, 80)).c_str(), known.c_str());
     return kExitBadInput;
   }
   try {
@@ -64,7 +69,8 @@ int main(int argc, char** argv) {
     try {
       return handler();
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "flocsim %s: error: %s\n", sub->get_name().c_str(), e.what());
+      std::fprintf(stderr, "flocsim %s: error: %s\n", sub->get_name().c_str(),
+                   printable(e.what()).c_str());
       return kExitFailure;
     }
   }

@@ -5,12 +5,15 @@
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "engine/case/scene.hpp"
 #include "engine/case/suspension_case.hpp"
 #include "engine/coupling/scheme.hpp"
 #include "engine/input/input_reader.hpp"
 #include "engine/output/atomic_file.hpp"
+#include "engine/text/printable.hpp"
 
 namespace flocsim::run {
 
@@ -65,6 +68,24 @@ void refuse_foreign_outputs(const fs::path& dir) {
                           (dir / kRunRecord).string() +
                           " does not say a run of this case wrote it; flocsim removes only what "
                           "it wrote, so move it away or use another --out directory");
+}
+
+// Throws when a place a run writes to is a symbolic link: the log is appended
+// to and the other files replaced, and through a link that is a file
+// elsewhere (a user's), which `flocsim run` must never change.
+void refuse_links(const fs::path& dir) {
+  std::vector<std::string> names = {"run.log", "result.json", "checkpoint.h5", kRunRecord};
+  for (const char* f : kOutputFiles) names.push_back(f);
+  for (const char* f : kSnapshotFolders) names.push_back(f);
+  std::string links;
+  for (const std::string& n : names)
+    if (fs::is_symlink(fs::symlink_status(dir / n)))
+      links += (links.empty() ? "" : ", ") + (dir / n).string();
+  if (!links.empty())
+    throw input::InputError(links +
+                            ": a symbolic link where this run writes its output; flocsim does not "
+                            "write through links (the file it points to would change), so remove "
+                            "the link or use another --out directory");
 }
 
 }  // namespace
@@ -145,6 +166,7 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
                             ": exists and is not a directory; --out must name a "
                             "directory");
   fs::create_directories(dir);
+  refuse_links(dir);
   bool completed = fs::exists(dir / "result.json");
   const bool checkpoint = fs::exists(dir / "checkpoint.h5");
   if (completed) {
@@ -171,7 +193,7 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
                                aside.string() + ", the run " +
                                (checkpoint ? "continues from its checkpoint" : "starts again");
       RunLog(dir / "run.log", true).warning(note);
-      std::cerr << "flocsim run: warning: " << note << "\n";
+      std::cerr << "flocsim run: warning: " << text::printable(note) << "\n";
       completed = false;
     }
   }

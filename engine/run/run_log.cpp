@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/output/atomic_file.hpp"
+#include "engine/text/printable.hpp"
 
 namespace flocsim::run {
 
@@ -45,7 +46,8 @@ void RunLog::info(const std::string& line) {
   file_.flush();
   if (quiet_) return;
   break_progress_line();
-  std::fprintf(stderr, "%s\n", line.c_str());
+  // a line may name the case's files and folders: shown, never obeyed
+  std::fprintf(stderr, "%s\n", text::printable(line).c_str());
 }
 
 void RunLog::progress_line(const std::string& line) {
@@ -53,11 +55,11 @@ void RunLog::progress_line(const std::string& line) {
   file_.flush();
   if (quiet_) return;
   if (terminal_) {
-    std::fprintf(stderr, "\r%-100s", line.c_str());
+    std::fprintf(stderr, "\r%-100s", text::printable(line).c_str());
     std::fflush(stderr);
     progress_open_ = true;
   } else {
-    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fprintf(stderr, "%s\n", text::printable(line).c_str());
   }
 }
 

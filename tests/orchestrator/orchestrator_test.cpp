@@ -4,10 +4,12 @@
 // database is then read back directly.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -394,6 +396,54 @@ TEST_F(Orchestrator, AResultOfAnotherCaseIsNeverRecordedAsThisRuns) {
   EXPECT_TRUE(fs::exists(run_dir(2) / "result.json"));
 }
 
+// Found by scripts/probe-cli.sh after item 1's fix: with the real worker,
+// another case's result.json in a run folder made `flocsim run --resume`
+// refuse (exit 2), so the run became `refused` for good ("change the case")
+// though its case was fine. The attempt now fails without starting a worker,
+// saying to move the file; once it is moved, the next resume runs the case.
+TEST_F(Orchestrator, AnotherCasesResultInARunFolderFailsTheAttemptUntilMoved) {
+  const auto tiny = [](double viscosity) {
+    return json{
+        {"scene", "fluid"},
+        {"fluid",
+         {{"size", {16, 4, 4}},
+          {"viscosity", viscosity},
+          {"initial",
+           {{"type", "shear_wave"}, {"amplitude", 0.01}, {"axis", "x"}, {"component", "y"}}}}},
+        {"run", {{"steps", 20}, {"threads", 1}}}};
+  };
+  t::write_text(dir_ / "other.json", tiny(0.02).dump());
+  ASSERT_EQ(t::run(flocsim({"run", (dir_ / "other.json").string(), "--out",
+                            (dir_ / "other").string(), "--quiet"}))
+                .code,
+            0);
+  t::write_text(dir_ / "s.json",
+                json{{"name", "s"}, {"base", tiny(0.04)}, {"axes", {{"run.steps", {20}}}}}.dump());
+  EXPECT_EQ(t::run(flocsim({"sweep", "launch", (dir_ / "s.json").string(), "--db", db_, "--worker",
+                            "/bin/false"}))
+                .code,
+            1);
+  const fs::path folder = ResultsDb(db_, ResultsDb::Mode::kExisting).runs().front().run_dir;
+  fs::copy_file(dir_ / "other" / "result.json", folder / "result.json");
+  const t::Output r = t::run(flocsim({"sweep", "resume", "--db", db_}));
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("no worker was started: move it out of the run folder"), std::string::npos)
+      << r.out;
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    EXPECT_EQ(to_string(db.runs().front().status), "failed") << db.runs().front().error;
+  }
+  EXPECT_TRUE(fs::exists(folder / "result.json"));  // not flocsim's to remove
+  fs::rename(folder / "result.json", dir_ / "moved.json");
+  const t::Output again = t::run(flocsim({"sweep", "resume", "--db", db_}));
+  EXPECT_EQ(again.code, 0) << again.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  ASSERT_EQ(db.result_rows().size(), 1u);
+  ASSERT_TRUE(db.result_rows().front().has_result);
+  const json result = json::parse(db.result_rows().front().result_json);
+  EXPECT_EQ(result["case"]["fluid"]["viscosity"], 0.04);
+}
+
 // Issue 41, item 6: the printed "restart what did not finish with: flocsim
 // sweep resume ... --sweep NAME" left the name unquoted, and a sweep named
 // $(touch${IFS}X) ran touch when the line was pasted into a shell.
@@ -486,6 +536,169 @@ TEST_F(Orchestrator, ControlAndBidiCharactersAreShownEscaped) {
   EXPECT_NE(l.out.find("evil\\u202egpj.exe"), std::string::npos) << l.out;
   EXPECT_NE(st.out.find("sweep n\\x1b[2Ja\\u202eme"), std::string::npos) << st.out;
   EXPECT_NE(q.out.find("\\u202e"), std::string::npos) << q.out;
+}
+
+// Bytes a terminal obeys, or that are not UTF-8, among those the test below
+// puts into names, values, paths and messages: none may reach the output raw.
+// Newlines are the output's own, so a name's newline is checked by finding
+// the name whole, escaped, in one line.
+std::string raw_bytes_in(const std::string& out) {
+  std::string found;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto b = static_cast<unsigned char>(out[i]);
+    if ((b < 0x20 && b != '\n') || b == 0x7f || b == 0xff || b == 0xfe ||
+        out.compare(i, 2, "\xc2\x9b") == 0 || out.compare(i, 3, "\xe2\x80\xae") == 0)
+      found += "byte " + std::to_string(b) + " at " + std::to_string(i) + "; ";
+  }
+  return found;
+}
+
+// Issue 41, item 7, the rest: a hostile database (names, points, messages,
+// bytes that are not UTF-8, a newline in a name) and hostile command-line
+// words reached the terminal raw through status, query, resume's progress
+// lines, the suggested commands and the error messages on stderr.
+TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
+  const std::string sweep = fake_sweep({1, 2}, 1, 1, {{"by_x", {{"2", {{"exit", 1}}}}}}, 5);
+  ASSERT_EQ(t::run(launch(sweep)).code, 1);
+  // U+001B [31m, U+202E, a newline, the byte 0xFF, U+009B (C1 CSI)
+  const std::string hostile = "n\x1b[31m\xe2\x80\xae\nx\xff\xc2\x9b";
+  const std::string shown = "n\\x1b[31m\\u202e\\x0ax\\xff\\u009b";
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(db_.c_str(), &db), SQLITE_OK);
+    const auto exec = [&](const char* sql, const std::string& a) {
+      sqlite3_stmt* st = nullptr;
+      ASSERT_EQ(sqlite3_prepare_v2(db, sql, -1, &st, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+      sqlite3_bind_text(st, 1, a.data(), static_cast<int>(a.size()), SQLITE_TRANSIENT);
+      EXPECT_EQ(sqlite3_step(st), SQLITE_DONE) << sqlite3_errmsg(db);
+      sqlite3_finalize(st);
+    };
+    exec("UPDATE sweeps SET name = ?1", hostile);
+    // a point that is JSON (its value holds ESC and U+202E as JSON escapes)
+    // for the failed run, one that is not for the completed run
+    exec(
+        "UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+        "(SELECT id FROM runs WHERE status = 'failed')",
+        R"({"x":"v\u001b[31m\u202e"})");
+    exec(
+        "UPDATE sweep_runs SET point_json = ?1 WHERE run_id IN "
+        "(SELECT id FROM runs WHERE status = 'completed')",
+        "{\"x\":\"\xff\"}");
+    exec("UPDATE runs SET error = ?1 WHERE status = 'failed'", "boom\x1b]0;title\x07 \xe2\x80\xae");
+    sqlite3_close(db);
+  }
+  const t::Output st = t::run(flocsim({"sweep", "status", "--db", db_}));
+  EXPECT_EQ(st.code, 0) << st.out;
+  EXPECT_EQ(raw_bytes_in(st.out), "") << st.out;
+  EXPECT_NE(st.out.find("sweep " + shown + ": 2 runs:"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("x=v\\x1b[31m\\u202e"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("boom\\x1b]0;title\\x07 \\u202e"), std::string::npos) << st.out;
+  // the suggested command: bash's $'...', the name's bytes as \xNN
+  const std::string quoted = "$'n\\x1b[31m\\xe2\\x80\\xae\\x0ax\\xff\\xc2\\x9b'";
+  EXPECT_NE(st.out.find("--sweep " + quoted), std::string::npos) << st.out;
+
+  for (const std::string format : {"table", "csv", "json"}) {
+    const t::Output q =
+        t::run(flocsim({"query", "--db", db_, "--sweep", hostile, "--format", format, "--all"}));
+    EXPECT_EQ(q.code, 0) << format << ": " << q.out;
+    EXPECT_EQ(raw_bytes_in(q.out), "") << format << ": " << q.out;
+  }
+  const t::Output j = t::run(flocsim({"query", "--db", db_, "--format", "json"}));
+  // JSON keeps the message (ESC and U+202E as JSON's escapes)
+  EXPECT_NE(j.out.find(R"("error": "boom\u001b]0;title\u0007 \u202e")"), std::string::npos)
+      << j.out;
+
+  const t::Output r = t::run(
+      flocsim({"sweep", "resume", "--db", db_, "--sweep", hostile, "--worker", FAKE_WORKER_EXE}));
+  EXPECT_EQ(r.code, 1) << r.out;  // x = 2 fails again
+  EXPECT_EQ(raw_bytes_in(r.out), "") << r.out;
+  EXPECT_NE(r.out.find("x=v\\x1b[31m\\u202e"), std::string::npos) << r.out;  // started ...
+  EXPECT_NE(r.out.find("--sweep " + quoted), std::string::npos) << r.out;
+
+  // stderr: the words given, as messages quote them
+  const std::string word = "zz\x1b[31m\n\xe2\x80\xae\xff";
+  const t::Output e1 = t::run(flocsim({"sweep", "status", "--db", db_, "--sweep", word}));
+  EXPECT_EQ(e1.code, 2) << e1.out;
+  EXPECT_EQ(raw_bytes_in(e1.out), "") << e1.out;
+  EXPECT_NE(e1.out.find("--sweep zz\\x1b[31m\\x0a\\u202e\\xff: no such sweep in "),
+            std::string::npos)
+      << e1.out;
+  const std::string missing_db = (dir_ / ("d" + word + ".db")).string();
+  for (const auto& args :
+       {std::vector<std::string>{"sweep", "status", "--db", missing_db},
+        std::vector<std::string>{"query", "--db", missing_db},
+        std::vector<std::string>{"run", missing_db, "--out", missing_db},
+        std::vector<std::string>{"sweep", "launch", missing_db, "--db", missing_db},
+        std::vector<std::string>{"sweep", "status", "--db", db_, "--lease", word},
+        std::vector<std::string>{word}}) {
+    const t::Output e = t::run(flocsim(args));
+    EXPECT_NE(e.code, 0) << args.front() << ": " << e.out;
+    EXPECT_EQ(raw_bytes_in(e.out), "") << args.front() << ": " << e.out;
+    EXPECT_NE(e.out.find("zz\\x1b[31m\\x0a\\u202e\\xff"), std::string::npos) << e.out;
+  }
+  EXPECT_FALSE(fs::exists(missing_db));
+
+  // launch: a sweep name from a file (ESC and U+202E as JSON escapes), a
+  // database and a runs folder whose paths hold them too
+  json s = t::read_json(sweep);
+  s["name"] = "l\x1b[31m\xe2\x80\xae";
+  t::write_text(dir_ / "l.json", s.dump());
+  const std::string odd = (dir_ / "o\x1b[31m\xe2\x80\xae").string();
+  fs::create_directories(odd);
+  const t::Output l =
+      t::run(flocsim({"sweep", "launch", (dir_ / "l.json").string(), "--db", odd + "/r.db",
+                      "--runs-dir", odd + "/runs", "--worker", FAKE_WORKER_EXE}));
+  EXPECT_EQ(l.code, 1) << l.out;
+  EXPECT_EQ(raw_bytes_in(l.out), "") << l.out;
+  EXPECT_NE(l.out.find("sweep l\\x1b[31m\\u202e: 2 runs (2 new, 0 already in " + dir_.string() +
+                       "/o\\x1b[31m\\u202e/r.db); run folders under " + dir_.string() +
+                       "/o\\x1b[31m\\u202e/runs"),
+            std::string::npos)
+      << l.out;
+}
+
+// Found by scripts/probe-cli.sh, beside issue 41's items 10 and 13: an sbatch
+// whose answer is not a job id was reported as "submitted job not a job id"
+// (exit 0); an sbatch that never answers held the launch through SIGTERM; and
+// a missing $FLOCSIM_WORKER, unlike --worker, was only found by failing runs.
+TEST_F(Orchestrator, SbatchWithoutAJobIdOrAnswerAndAMissingEnvWorkerAreSaid) {
+  const fs::path bin = dir_ / "fake-slurm";
+  fs::create_directories(bin);
+  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+  t::write_text(bin / "sbatch", "#!/bin/sh\necho 'sbatch: queued somewhere'\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  fs::permissions(bin / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  const std::string sweep = fake_sweep({1}, 1, 1);
+  const t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--backend", "slurm",
+                                      "--no-wait", "--worker", FAKE_WORKER_EXE}),
+                             {path});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("answered \"sbatch: queued somewhere"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("where --parsable gives the job id"), std::string::npos) << o.out;
+  EXPECT_EQ(o.out.find("submitted job"), std::string::npos) << o.out;
+
+  t::write_text(bin / "sbatch", "#!/bin/sh\ntouch \"$(dirname \"$0\")/asked\"\nexec sleep 60\n");
+  // env execs flocsim: the pid is flocsim's
+  t::Background b = t::start({"/usr/bin/env", path, FLOCSIM_EXE, "sweep", "resume", "--db", db_,
+                              "--backend", "slurm", "--no-wait", "--worker", FAKE_WORKER_EXE},
+                             (dir_ / "hung.log").string());
+  ASSERT_TRUE(t::wait_for([&] { return fs::exists(bin / "asked"); }, 20));  // sbatch runs
+  kill(b.pid, SIGTERM);
+  const auto begin = std::chrono::steady_clock::now();
+  EXPECT_EQ(b.wait(20), 1) << t::read_text(dir_ / "hung.log");
+  EXPECT_LT(std::chrono::steady_clock::now() - begin, std::chrono::seconds(10));
+  EXPECT_NE(t::read_text(dir_ / "hung.log").find("stopped: flocsim was asked to stop"),
+            std::string::npos)
+      << t::read_text(dir_ / "hung.log");
+
+  const std::string missing = (dir_ / "no-such-worker").string();
+  const t::Output e =
+      t::run(flocsim({"sweep", "resume", "--db", db_}), {"FLOCSIM_WORKER=" + missing});
+  EXPECT_EQ(e.code, 2) << e.out;
+  EXPECT_NE(e.out.find("FLOCSIM_WORKER=" + missing + ": no such file"), std::string::npos) << e.out;
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 0);
 }
 
 TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {

@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "engine/input/input_reader.hpp"
+#include "engine/text/printable.hpp"
 
 using flocsim::input::InputError;
 using nlohmann::json;
@@ -49,6 +52,68 @@ TEST(ShellWord, PlainWordsStayAndEverythingElseIsSingleQuoted) {
   EXPECT_EQ(orc::shell_word("my runs/d.sqlite"), "'my runs/d.sqlite'");
   EXPECT_EQ(orc::shell_word("bob's"), "'bob'\\''s'");
   EXPECT_EQ(orc::shell_word(""), "''");
+}
+
+// Issue 41, item 7: what a terminal is given of a name, a value or a path.
+// Each expectation is worked by hand from the bytes (UTF-8, RFC 3629).
+TEST(Printable, ControlsAndBidiAreEscapedAndOtherUtf8IsKept) {
+  using flocsim::text::printable;
+  EXPECT_EQ(printable("demo phi=0.2 Å φ 😀"), "demo phi=0.2 Å φ 😀");
+  EXPECT_EQ(printable("red\x1b[31m!"), "red\\x1b[31m!");
+  EXPECT_EQ(printable("a\nb\rc\td\x7f"), "a\\x0ab\\x0dc\\x09d\\x7f");
+  EXPECT_EQ(printable(std::string("nul\0x", 5)), "nul\\x00x");
+  EXPECT_EQ(printable("evil\xe2\x80\xaegpj.exe"), "evil\\u202egpj.exe");  // U+202E
+  EXPECT_EQ(printable("\xe2\x80\xaa\xe2\x80\xab\xe2\x80\xac\xe2\x80\xad"),
+            "\\u202a\\u202b\\u202c\\u202d");
+  EXPECT_EQ(printable("\xe2\x81\xa6x\xe2\x81\xa9"), "\\u2066x\\u2069");  // LRI, PDI
+  EXPECT_EQ(printable("\xe2\x80\x8f\xd8\x9c"), "\\u200f\\u061c");        // RLM, ALM
+  EXPECT_EQ(printable("l\xe2\x80\xa8p"), "l\\u2028p");                   // line separator
+  EXPECT_EQ(printable("csi\xc2\x9b"
+                      "31m \xc2\x85"),
+            "csi\\u009b31m \\u0085");  // C1
+  // not UTF-8: each byte as it is
+  EXPECT_EQ(printable("\xff\xfe"), "\\xff\\xfe");
+  EXPECT_EQ(printable("lone\x80"), "lone\\x80");
+  EXPECT_EQ(printable("cut\xe2\x80"), "cut\\xe2\\x80");
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");                    // overlong "/"
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");           // a surrogate
+  EXPECT_EQ(printable("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");  // above U+10FFFF
+  EXPECT_EQ(printable("\xe2\x80\xaeZ\xe2"), "\\u202eZ\\xe2");
+  // only printable ASCII is added: escaping twice changes nothing more
+  const std::string hostile = "n\x1b[2J\xe2\x80\xae\n\xff\xc2\x9b";
+  EXPECT_EQ(printable(printable(hostile)), printable(hostile));
+  EXPECT_EQ(printable(hostile), "n\\x1b[2J\\u202e\\x0a\\xff\\u009b");
+}
+
+TEST(Printable, JsonTextKeepsItsMeaning) {
+  using flocsim::text::printable_json;
+  // nlohmann writes C0 as \u001b already; DEL, C1 and bidi become JSON escapes
+  const json j = {{"name", "a\x1b\x7f\xc2\x9b\xe2\x80\xae Å"}};
+  const std::string shown = printable_json(j.dump());
+  EXPECT_EQ(shown, "{\"name\":\"a\\u001b\\u007f\\u009b\\u202e Å\"}");
+  EXPECT_EQ(json::parse(shown), j);
+}
+
+// A word holding what a terminal would obey is written as bash's $'...'; the
+// shell gives back the very bytes (checked by bash itself where it is found).
+TEST(ShellWord, ControlBidiAndNonUtf8WordsAreAnsiCQuoted) {
+  EXPECT_EQ(orc::shell_word("a\x1b[31mb"), "$'a\\x1b[31mb'");
+  EXPECT_EQ(orc::shell_word("it's\n"), "$'it\\'s\\x0a'");
+  EXPECT_EQ(orc::shell_word("x\xe2\x80\xae\\y"), "$'x\\xe2\\x80\\xae\\\\y'");
+  EXPECT_EQ(orc::shell_word("\xff Å"), "$'\\xff Å'");
+  if (access("/bin/bash", X_OK) != 0) GTEST_SKIP() << "no /bin/bash to paste into";
+  for (const std::string& word : {std::string("a\x1b[31mb"), std::string("it's\n"),
+                                  std::string("x\xe2\x80\xae\\y"), std::string("\xff Å $(id)")}) {
+    const std::string file = testing::TempDir() + "shell_word_" + std::to_string(getpid());
+    // the command line goes through sh first: quoted once more for it
+    const std::string sh =
+        "/bin/bash -c " + orc::shell_word("printf %s " + orc::shell_word(word) + " > " + file);
+    ASSERT_EQ(std::system(sh.c_str()), 0) << sh;
+    std::ifstream in(file, std::ios::binary);
+    const std::string back((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(back, word);
+    std::filesystem::remove(file);
+  }
 }
 
 TEST(Canonical, SortsKeysAndNormalisesNumbers) {

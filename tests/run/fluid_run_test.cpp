@@ -375,6 +375,32 @@ TEST(OutputDirectory, AFreshRunNeverRemovesAUsersFiles) {
   fs::remove_all(o);
 }
 
+// Found by scripts/probe-cli.sh: a run.log in --out that is a symbolic link
+// had the run's log appended to the file it points to (a user's file). Every
+// place a run writes is checked for a link before any work.
+TEST(OutputDirectory, ALinkWhereTheRunWritesIsRefusedAndItsTargetKept) {
+  const fs::path o = fresh_dir("linked_outputs");
+  const fs::path mine = o.parent_path() / "linked_outputs_mine.txt";
+  std::ofstream(mine) << "mine\n";
+  for (const std::string name : {"run.log", "progress.json", "flocsim-run.json", "series.h5"}) {
+    fs::remove_all(o);
+    fs::create_directories(o);
+    fs::create_symlink(mine, o / name);
+    try {
+      run_fluid_case(small_case(0.05), {o, false, true, 0});
+      ADD_FAILURE() << name << ": a run wrote through a link";
+    } catch (const input::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find((o / name).string() + ": a symbolic link"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(text_of(mine), "mine\n") << name;
+    EXPECT_TRUE(fs::is_symlink(o / name)) << name;
+  }
+  fs::remove_all(o);
+  fs::remove(mine);
+}
+
 TEST(OutputDirectory, AFreshStartOfTheSameCaseReplacesOnlyItsOwnSnapshots) {
   // An attempt that died before its first checkpoint left snapshots; the next
   // attempt of the same case (the orchestrator's retry) removes those by name

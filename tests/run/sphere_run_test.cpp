@@ -7,8 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "engine/case/suspension_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -59,6 +61,50 @@ TEST(SphereRun, GranularStopAndResumeIsBitIdentical) {
   EXPECT_EQ(pa, pb);
   fs::remove_all(straight);
   fs::remove_all(split);
+}
+
+// Issue 41, item 20: the user guide says sphere snapshots are written every
+// snapshot_every a/U_inf and at the end, and that snapshot_every 0 writes none
+// at all. Snapshot steps are worked out here from the case's convective time:
+// every round(4 T) steps, and the last step.
+TEST(SphereRun, SnapshotsEveryIntervalAndAtTheEndAndNoneAtZero) {
+  const auto with_snapshots = [](double every) {
+    json c = json::parse(R"({
+      "scene": "granular", "fidelity": "draft", "phi": 0.25, "Re_inf": 12, "du_over_Uinf": 0,
+      "protocol": {"stage1_min": 2, "stage1_max": 2, "stage2_settle": 1, "statistics": 4,
+                   "stationarity_window": 1, "sample_every": 0.1}})");
+    c["protocol"]["snapshot_every"] = every;
+    return cases::parse_suspension_case(c);
+  };
+  const auto snapshots = [](const fs::path& dir) {
+    std::set<long> steps;
+    if (!fs::exists(dir / "spheres")) return steps;
+    for (const auto& f : fs::directory_iterator(dir / "spheres")) {
+      const std::string n = f.path().filename().string();
+      if (n.rfind("step_", 0) == 0 && f.path().extension() == ".h5")
+        steps.insert(std::stol(n.substr(5, n.size() - 8)));
+    }
+    return steps;
+  };
+  const cases::SuspensionCase none = with_snapshots(0);
+  const fs::path a = fresh_dir("snapshots_none");
+  ASSERT_EQ(run_sphere_case(none, {a, false, true, 0}).outcome, RunOutcome::completed);
+  EXPECT_EQ(snapshots(a), std::set<long>{});
+
+  const cases::SuspensionCase every4 = with_snapshots(4);
+  const fs::path b = fresh_dir("snapshots_every4");
+  const RunReport r = run_sphere_case(every4, {b, false, true, 0});
+  ASSERT_EQ(r.outcome, RunOutcome::completed);
+  const long last = r.result["cost"]["steps"].get<long>();
+  const long interval = std::lround(4 * every4.derived.convective_time);
+  ASSERT_GT(interval, 0);
+  std::set<long> expected{last};
+  for (long s = interval; s <= last; s += interval) expected.insert(s);
+  EXPECT_EQ(snapshots(b), expected) << "last step " << last << ", interval " << interval;
+  EXPECT_NE(last % interval, 0) << "pick a protocol whose end is off the interval: last step "
+                                << last << ", interval " << interval;
+  fs::remove_all(a);
+  fs::remove_all(b);
 }
 
 TEST(SphereRun, ElasticGasConservesKineticMinusWellEnergy) {
