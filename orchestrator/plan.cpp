@@ -461,7 +461,7 @@ void write_plan(const SweepPlan& p, std::ostream& out, bool every_run) {
     out << "  " << index << ". " << printable(c.description) << ": " << c.runs << " run"
         << (c.runs == 1 ? "" : "s");
     if (c.measured) out << ", " << bytes_text(c.measured->memory_bytes) << " of memory each";
-    out << "\n     " << c.basis() << "\n";
+    out << "\n     " << printable(c.basis()) << "\n";
   }
 
   if (p.to_run == 0) {

@@ -99,7 +99,7 @@ CASE
 done
 
 # 5. the paper's case (phi 0.2, Re_inf 12, du 0.025, the paper preset: a = 6,
-#    288 x 144 x 144, N = 1320) on the GPU for 3000 steps (10 a/U_inf), and
+#    288 x 144 x 144, N = 1320) on the GPU for 1500 steps (5 a/U_inf), and
 #    on the CPU for 30, stopped as if by SIGTERM (exit 3, a checkpoint): their
 #    logs give the full step's rate on each, run.log the modules' split
 cat > "$out/paper-case.json" <<CASE
@@ -107,7 +107,7 @@ cat > "$out/paper-case.json" <<CASE
  "density_ratio": 4.0, "delta_over_a": 0.025, "protocol": {"progress_every_s": 5}}
 CASE
 for device in cuda cpu; do
-  steps=3000
+  steps=1500
   [[ $device == cpu ]] && steps=30
   ok_codes="0 3"  # a stop on request exits 3: that is this step's success
   step "run-paper-case-$device" 35 "$bundle/bin/flocsim" run "$out/paper-case.json" \

@@ -55,7 +55,6 @@ struct SphereLaunch {
   Real* increment = nullptr;     // F_m dV per marker, 4 lanes
   int markers = 0, B = 0, sweeps = 1;
   bool control = false;
-  bool force_in_shared = false;  // the box's force in the block's shared memory
   double input_radius = 0, dV = 0;
   Real integral_gain = 0, proportional_gain = 0;
 };
@@ -67,8 +66,8 @@ struct AtomicAdd {
   }
 };
 
-// Sums v over the block's threads, six numbers each, in a fixed tree;
-// thread 0 receives the result.
+// Sums v over the block's threads (blockDim.x == kThreads, as launched), six
+// numbers each, in a fixed tree; every thread receives the result.
 __device__ void block_sum6(double (&v)[6], double (*shared)[kThreads]) {
   for (int q = 0; q < 6; ++q) shared[q][threadIdx.x] = v[q];
   __syncthreads();
@@ -131,14 +130,19 @@ __device__ void spread_increments(const SphereLaunch<Real>& p, const SphereBox<R
 
 template <class Real>
 __device__ void zero_box_force(const SphereBox<Real>& box) {
-  const long cells = static_cast<long>(box.B) * box.B * box.B;
-  for (long c = threadIdx.x; c < 4 * cells; c += blockDim.x) box.force[c] = 0;
+  const int numbers = 4 * box.B * box.B * box.B;  // B^3 is a few thousand
+  for (int c = threadIdx.x; c < numbers; c += blockDim.x) box.force[c] = 0;
 }
 
-// Two blocks per multiprocessor (float: 2 x 91 KB of shared memory) with no
-// register spills: at most 128 registers a thread.
-template <class Real, int W>
-__global__ void __launch_bounds__(kThreads, 2) sphere_kernel(SphereLaunch<Real> p) {
+// Float: two blocks per multiprocessor (2 x 91 KB of shared memory), so at
+// most 128 registers a thread (no spills); double: one block fits (169 KB),
+// and the registers are not capped below what it needs.
+// InShared: the box's force in the block's shared memory (a pointer the
+// compiler knows to be shared, so the spreading's additions are shared-memory
+// atomics), else in the global scratch.
+template <class Real, int W, bool InShared>
+__global__ void __launch_bounds__(kThreads, sizeof(Real) == 4 ? 2 : 1)
+    sphere_kernel(SphereLaunch<Real> p) {
   __shared__ double shared[6][kThreads];
   extern __shared__ __align__(16) unsigned char box_shared[];
   const int s = blockIdx.x;
@@ -147,20 +151,22 @@ __global__ void __launch_bounds__(kThreads, 2) sphere_kernel(SphereLaunch<Real> 
   const double up[3] = {pose[3], pose[4], pose[5]};
   const double omega[3] = {pose[6], pose[7], pose[8]};
   const int B = p.B;
-  const long cells = static_cast<long>(B) * B * B;
+  const int cells = B * B * B;  // a few thousand: int arithmetic in the loops
   SphereBox<Real> box;
   box.B = B;
-  box.velocity = p.box_velocity + 4 * cells * s;
+  box.velocity = p.box_velocity + 4 * static_cast<long>(cells) * s;
   // The spreading's atomic additions go to shared memory where the box fits
   // (a = 6 in float: 79 KB; in double 157 KB), else to the global scratch.
-  box.force = p.force_in_shared ? reinterpret_cast<Real*>(box_shared) : p.box_force + 4 * cells * s;
+  if constexpr (InShared)
+    box.force = reinterpret_cast<Real*>(box_shared);
+  else
+    box.force = p.box_force + 4 * static_cast<long>(cells) * s;
   for (int d = 0; d < 3; ++d)
     box.lo[d] = static_cast<int>(::floor(centre[d] - p.input_radius)) - 2;
 
   // load: the velocity the next collision would see without per-cell force
-  for (long c = threadIdx.x; c < cells; c += blockDim.x) {
-    const int i = static_cast<int>(c % B), j = static_cast<int>((c / B) % B),
-              k = static_cast<int>(c / (static_cast<long>(B) * B));
+  for (int c = threadIdx.x; c < cells; c += blockDim.x) {
+    const int i = c % B, j = (c / B) % B, k = c / (B * B);
     const int x = immersed_boundary::wrap_coordinate(box.lo[0] + i, p.slots.nx);
     const int y = immersed_boundary::wrap_coordinate(box.lo[1] + j, p.slots.ny);
     const int z = immersed_boundary::wrap_coordinate(box.lo[2] + k, p.slots.nz);
@@ -211,9 +217,8 @@ __global__ void __launch_bounds__(kThreads, 2) sphere_kernel(SphereLaunch<Real> 
 
   // inside: the liquid's momentum and angular momentum
   double inside[6] = {0, 0, 0, 0, 0, 0};
-  for (long c = threadIdx.x; c < cells; c += blockDim.x) {
-    const int i = static_cast<int>(c % B), j = static_cast<int>((c / B) % B),
-              k = static_cast<int>(c / (static_cast<long>(B) * B));
+  for (int c = threadIdx.x; c < cells; c += blockDim.x) {
+    const int i = c % B, j = (c / B) % B, k = c / (B * B);
     double P[3], L[3];
     if (immersed_boundary::inside_share(box, i, j, k, centre, p.input_radius, P, L))
       for (int d = 0; d < 3; ++d) {
@@ -229,11 +234,10 @@ __global__ void __launch_bounds__(kThreads, 2) sphere_kernel(SphereLaunch<Real> 
   }
 
   // write: the box's force onto the lattice's field
-  for (long c = threadIdx.x; c < cells; c += blockDim.x) {
+  for (int c = threadIdx.x; c < cells; c += blockDim.x) {
     const Real* F = box.force + 4 * c;
     if (F[1] == 0 && F[2] == 0 && F[3] == 0) continue;
-    const int i = static_cast<int>(c % B), j = static_cast<int>((c / B) % B),
-              k = static_cast<int>(c / (static_cast<long>(B) * B));
+    const int i = c % B, j = (c / B) % B, k = c / (B * B);
     const int x = immersed_boundary::wrap_coordinate(box.lo[0] + i, p.slots.nx);
     const int y = immersed_boundary::wrap_coordinate(box.lo[1] + j, p.slots.ny);
     const int z = immersed_boundary::wrap_coordinate(box.lo[2] + k, p.slots.nz);
@@ -311,11 +315,11 @@ MarkerKernels<Real>::MarkerKernels(MarkerSetup setup)
   const std::size_t box_bytes =
       sizeof(Real) * 4 * static_cast<std::size_t>(setup_.box) * setup_.box * setup_.box;
   if (static_cast<std::size_t>(optin) >= reduction + box_bytes) {
-    cuda_check(cudaFuncSetAttribute(sphere_kernel<Real, 3>,
+    cuda_check(cudaFuncSetAttribute(sphere_kernel<Real, 3, true>,
                                     cudaFuncAttributeMaxDynamicSharedMemorySize,
                                     static_cast<int>(box_bytes)),
                "shared memory of the immersed boundary");
-    cuda_check(cudaFuncSetAttribute(sphere_kernel<Real, 2>,
+    cuda_check(cudaFuncSetAttribute(sphere_kernel<Real, 2, true>,
                                     cudaFuncAttributeMaxDynamicSharedMemorySize,
                                     static_cast<int>(box_bytes)),
                "shared memory of the immersed boundary");
@@ -410,7 +414,6 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
   p.B = setup_.box;
   p.sweeps = setup_.sweeps;
   p.control = setup_.control;
-  p.force_in_shared = in_shared;
   p.input_radius = setup_.input_radius;
   p.dV = setup_.marker_volume;
   p.integral_gain = static_cast<Real>(setup_.integral_gain);
@@ -421,11 +424,18 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
         dev.increment, dev.marker_force, lanes, static_cast<Real>(setup_.marker_volume));
     cuda_check(cudaGetLastError(), "launch of the carried increments");
   }
-  const std::size_t dynamic = in_shared ? box_bytes : 0;
-  if (setup_.kernel_width == 3)
-    sphere_kernel<Real, 3><<<static_cast<unsigned>(n), kThreads, dynamic>>>(p);
-  else
-    sphere_kernel<Real, 2><<<static_cast<unsigned>(n), kThreads, dynamic>>>(p);
+  const unsigned blocks = static_cast<unsigned>(n);
+  if (in_shared) {
+    if (setup_.kernel_width == 3)
+      sphere_kernel<Real, 3, true><<<blocks, kThreads, box_bytes>>>(p);
+    else
+      sphere_kernel<Real, 2, true><<<blocks, kThreads, box_bytes>>>(p);
+  } else {
+    if (setup_.kernel_width == 3)
+      sphere_kernel<Real, 3, false><<<blocks, kThreads>>>(p);
+    else
+      sphere_kernel<Real, 2, false><<<blocks, kThreads>>>(p);
+  }
   cuda_check(cudaGetLastError(), "launch of the immersed boundary");
   cuda_check(cudaMemcpyAsync(dev.pinned_loads, dev.loads, sizeof(double) * kLoadNumbers * n,
                              cudaMemcpyDeviceToHost),
@@ -467,6 +477,10 @@ void MarkerKernels<Real>::restore(const std::vector<Real>& force, const std::vec
         "whole spheres in both");
   Device& dev = *device_;
   const std::size_t n = force.size() / per_sphere;
+  if (force.empty()) {  // no spheres: nothing carried
+    dev.spheres = 0;
+    return;
+  }
   device_resize(dev.marker_force, dev.force_held, force.size(), "the marker forces");
   device_resize(dev.marker_slip, dev.slip_held, slip.size(), "the marker slips");
   cuda_check(cudaMemcpy(dev.marker_force, force.data(), sizeof(Real) * force.size(),

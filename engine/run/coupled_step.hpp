@@ -97,8 +97,10 @@ struct Liquid {
     }
   }
   // The mirror up to date with the GPU: populations and the force field.
+  // Nothing to do where it already is (a sample and a checkpoint on one step:
+  // the field changes only in the coupling's apply(), before a step).
   void to_host() {
-    if (!device) return;
+    if (!device || fluid.time_step() == device->time_step()) return;
     device->download(fluid);
     device->download_force_field(fluid);
   }

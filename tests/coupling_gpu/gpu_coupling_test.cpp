@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "engine/case/case_file.hpp"
@@ -211,17 +212,29 @@ TEST(GpuCoupling, ASuspensionsCoupledStepFollowsTheCpuTrajectories) {
   run::place_spheres(c, cases::modules_of(c.scene), cpu.box(), s_cpu);
   spheres::SphereSet s_gpu = s_cpu;
   gpu.liquid()->to_device();
-  for (int step = 0; step < 300; ++step) {
+  // the largest velocity difference every 50 steps: a smooth growth is
+  // round-off carried by the flow, a jump an event decided differently
+  auto largest_difference = [&] {
+    double worst = 0;
+    for (std::size_t i = 0; i < s_cpu.size(); ++i)
+      worst = std::max(worst, (s_gpu.velocity[i] - s_cpu.velocity[i]).norm());
+    return worst;
+  };
+  std::string growth;
+  for (int step = 1; step <= 300; ++step) {
     ASSERT_EQ(cpu.advance(s_cpu), "") << "step " << step;
     ASSERT_EQ(gpu.advance(s_gpu), "") << "step " << step;
+    if (step % 50 == 0) {
+      char entry[48];
+      std::snprintf(entry, sizeof entry, " %d: %.2e", step, largest_difference());
+      growth += entry;
+    }
   }
-  double worst = 0, fastest = 0;
-  for (std::size_t i = 0; i < s_cpu.size(); ++i) {
-    worst = std::max(worst, (s_gpu.velocity[i] - s_cpu.velocity[i]).norm());
-    fastest = std::max(fastest, s_cpu.velocity[i].norm());
-  }
+  double fastest = 0;
+  for (const Vec3& v : s_cpu.velocity) fastest = std::max(fastest, v.norm());
   ASSERT_GT(fastest, 1e-4) << "the spheres did not move: the comparison would prove little";
-  EXPECT_LE(worst, 1e-8 * fastest) << "largest velocity difference after 300 steps";
+  EXPECT_LE(largest_difference(), 1e-8 * fastest)
+      << "largest velocity difference after 300 steps; by step:" << growth;
   // and the liquid the observables read: the mirror brought up to date
   gpu.liquid()->to_host();
   EXPECT_NEAR(gpu.liquid()->fluid.total_mass(), cpu.liquid()->fluid.total_mass(),
