@@ -483,6 +483,14 @@ void read_scheme(InputReader& num, Reading& r) {
   SuspensionCase& c = r.c;
   c.numerics.trt_magic = case_number(num, "trt_magic");
   c.numerics.inside_liquid = case_choice(num, "inside_liquid");
+  if (!has_liquid(c)) {
+    // no coupling runs: its options (checked and warned about by
+    // check_fields) are not read, and no rule between them applies
+    case_choice(num, "coupling");
+    num.object("immersed_boundary");
+    c.numerics.coupling = r.p.coupling;
+    return;
+  }
   c.numerics.coupling = choose_scheme(num, r);
   // By default also stay clear of the multi-sweep coupling's oscillation
   // (check_multi_sweep_floor): raise U_inf until nu reaches its floor, where
@@ -503,6 +511,10 @@ void read_scheme(InputReader& num, Reading& r) {
 void read_input_radius(InputReader& num, SuspensionCase& c) {
   c.numerics.input_radius_given = num.has("input_radius");
   if (!c.numerics.input_radius_given) return;
+  if (!has_liquid(c)) {  // no markers: the field's own range only (check_fields warns)
+    c.numerics.input_radius = case_number(num, "input_radius");
+    return;
+  }
   const double a = c.numerics.radius_cells;
   const coupling::Scheme& s = c.numerics.coupling;
   const Range range =

@@ -110,6 +110,16 @@ void check_value(const FieldSpec& f, const nlohmann::json& v) {
   }
 }
 
+// The first field given inside `value` at `path` (itself when not a
+// non-empty object), with its value.
+std::pair<std::string, nlohmann::json> first_leaf(std::string path, nlohmann::json value) {
+  while (value.is_object() && !value.empty()) {
+    path += "." + value.begin().key();
+    value = nlohmann::json(value.begin().value());
+  }
+  return {path, value};
+}
+
 void walk(const FieldTable& table, const nlohmann::json& object, const std::string& parent,
           int context, bool quiet, std::vector<std::string>& warnings) {
   const std::string context_name =
@@ -123,8 +133,11 @@ void walk(const FieldTable& table, const nlohmann::json& object, const std::stri
     bool quiet_below = quiet;
     // inside an object already warned about as unused, its fields are only checked
     if (!applies(f, context) && !quiet) {
+      // a refused object is named by the first field given in it ("run.steps =
+      // 10"), so that the message names the field the user wrote
+      const auto [path, value] = first_leaf(f.path, *it);
       if (!f.warn_when_unused)
-        throw InputError(f.path + " = " + shown(*it, 40) + ": only for " + table.context_field +
+        throw InputError(path + " = " + shown(value, 40) + ": only for " + table.context_field +
                          " " + table.contexts_text(f) + " (" + table.context_field + " = \"" +
                          context_name + "\"" + (f.unused.empty() ? "" : ", which " + f.unused) +
                          ")");

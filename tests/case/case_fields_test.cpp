@@ -143,7 +143,7 @@ TEST(CaseFields, FieldsOfOtherScenesAreRefusedOrWarnedUniformly) {
                                 HasSubstr("scene = \"single-sphere\"")));
   c = valid_case("suspension");
   c["run"] = {{"steps", 10}};
-  EXPECT_THAT(refusal(c), AllOf(HasSubstr("run = {\"steps\":10}: only for scene \"fluid\"")));
+  EXPECT_THAT(refusal(c), AllOf(HasSubstr("run.steps = 10: only for scene \"fluid\"")));
   c = valid_case("fluid");
   c["Re_inf"] = 12;
   EXPECT_THAT(refusal(c),
