@@ -41,11 +41,10 @@ FieldTable make_table() {
                .fallback = 3,
                .doc = "failed attempts per run before it is left failed"});
   t.push_back({.path = "fidelity",
-               .type = FieldType::choice,
-               .choices = cases::case_field("fidelity").choices,
+               .type = FieldType::string,
                .default_rule = "base.fidelity, or the case's default",
-               .doc = "written into every run's case as its fidelity",
-               .rules = "not also in base, not also an axis"});
+               .doc = "written into every run's case as its fidelity (draft, standard, paper)",
+               .rules = "not also in base, not also an axis; each grid point's case checks it"});
   t.push_back({.path = "base",
                .type = FieldType::object,
                .default_rule = "required",
