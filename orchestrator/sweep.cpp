@@ -8,8 +8,10 @@
 #include <set>
 #include <sstream>
 
+#include "engine/input/field_table.hpp"
 #include "engine/input/input_reader.hpp"
 #include "orchestrator/plan.hpp"
+#include "orchestrator/sweep_fields.hpp"
 #include "orchestrator/terminal_table.hpp"
 
 namespace flocsim::orchestrator {
@@ -173,65 +175,25 @@ std::optional<json> get_path(const json& object, const std::string& path) {
   return *node;
 }
 
-SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& origin) {
-  const std::string where = "sweep file " + origin;
-  if (!file.is_object())
-    throw InputError(where + ": must hold a JSON object, found " + describe(json(file)));
-  SweepSpec s;
-  s.source = json(file);
-  try {
-    flocsim::input::InputReader in(s.source, "");
-    s.name = in.text("name");
-    if (s.name.empty() || s.name.find_first_of(" \t\n\r\v\f/\\") != std::string::npos)
-      throw InputError("name = \"" + s.name +
-                       "\": must be a non-empty word without spaces or slashes");
-    s.description = in.text("description", "");
-    s.max_attempts =
-        static_cast<int>(in.integer("max_attempts", {.at_least = 1, .at_most = 100}, 3));
-    if (in.has("fidelity")) s.fidelity = in.text("fidelity");
-    in.object("base", true);  // checked to be an object; contents are the worker's business
-    in.object("axes", true);
-    flocsim::input::InputReader slurm = in.object("slurm");
-    s.slurm.runs_per_task =
-        static_cast<int>(slurm.integer("runs_per_task", {.at_least = 1, .at_most = 10000}, 1));
-    s.slurm.time_limit = slurm.text("time_limit", "01:00:00");
-    s.slurm.partition = slurm.text("partition", "");
-    s.slurm.gres = slurm.text("gres", "");
-    // both go into the job script's #SBATCH lines: one word each, so that no
-    // value can end a line and start a shell command there
-    for (const auto& [field, value] :
-         {std::pair<std::string, std::string>{"slurm.time_limit", s.slurm.time_limit},
-          {"slurm.partition", s.slurm.partition},
-          {"slurm.gres", s.slurm.gres}})
-      if (value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                  "0123456789:-_.,") != std::string::npos)
-        throw InputError(field + " = " + flocsim::input::shown(value) +
-                         ": must be one word of letters, digits and : - _ . , (Slurm's syntax)");
-    // read here, when the sweep is read: "abc" went to sbatch after the sweep
-    // was registered, twenty digits stopped the plan with "error: stol"
-    if (!slurm_time_limit_s(s.slurm.time_limit) && s.slurm.time_limit != "UNLIMITED" &&
-        s.slurm.time_limit != "INFINITE")
-      throw InputError("slurm.time_limit = " + flocsim::input::shown(s.slurm.time_limit) +
-                       ": not a Slurm time limit; allowed: MINUTES, MINUTES:SECONDS, "
-                       "HOURS:MINUTES:SECONDS, DAYS-HOURS, DAYS-HOURS:MINUTES, "
-                       "DAYS-HOURS:MINUTES:SECONDS (numbers of at most 9 digits) or UNLIMITED");
-    s.slurm.max_parallel =
-        static_cast<int>(slurm.integer("max_parallel", {.at_least = 0, .at_most = 100000}, 0));
-    s.slurm.cpus_per_task =
-        static_cast<int>(slurm.integer("cpus_per_task", {.at_least = 1, .at_most = 1024}, 1));
-    slurm.finish();
-    in.finish();
-  } catch (const InputError& e) {
-    throw InputError(where + ": " + e.what());
-  }
-  s.base = s.source["base"];
-  if (s.fidelity) {
-    if (s.base.contains("fidelity"))
-      throw InputError(where + ": fidelity is given both at the top level (\"" + *s.fidelity +
-                       "\") and in base.fidelity (" + describe(s.base["fidelity"]) +
-                       "); give it once");
-    s.base["fidelity"] = *s.fidelity;
-  }
+namespace {
+// A sweep field's range and default, from its declaration (sweep_fields.cpp).
+const flocsim::input::FieldSpec& sweep_field(const std::string& path) {
+  const flocsim::input::FieldSpec* f = sweep_field_table().find(path);
+  if (!f) throw std::logic_error("sweep field " + path + " is not declared");
+  return *f;
+}
+const flocsim::input::Range& range_of(const std::string& path) {
+  return sweep_field(path).range;
+}
+long fallback_integer(const std::string& path) {
+  return sweep_field(path).fallback.get<long>();
+}
+std::string fallback_text(const std::string& path) {
+  return sweep_field(path).fallback.get<std::string>();
+}
+// The axes: each a dotted case path with a non-empty array of distinct
+// scalars; none inside another; at most kMaxRunsPerSweep points in all.
+void read_axes(const nlohmann::ordered_json& file, const std::string& where, SweepSpec& s) {
   std::size_t total = 1;
   for (auto it = file["axes"].begin(); it != file["axes"].end(); ++it) {
     const std::string& path = it.key();
@@ -270,6 +232,73 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& ori
         throw InputError(where + ": axes \"" + a + "\" and \"" + b +
                          "\" overlap (one lies inside the other)");
     }
+}
+
+}  // namespace
+
+SweepSpec parse_sweep(const nlohmann::ordered_json& file, const std::string& origin) {
+  const std::string where = "sweep file " + origin;
+  if (!file.is_object())
+    throw InputError(where + ": must hold a JSON object, found " + describe(json(file)));
+  SweepSpec s;
+  s.source = json(file);
+  try {
+    // every field against its declaration (sweep_fields.cpp): unknown keys
+    // with the nearest known one, types, ranges, Slurm's one-word syntax
+    flocsim::input::check_fields(sweep_field_table(), s.source, -1);
+    flocsim::input::InputReader in(s.source, "");
+    s.name = in.text("name");
+    if (s.name.empty() || s.name.find_first_of(" \t\n\r\v\f/\\") != std::string::npos)
+      throw InputError("name = \"" + s.name +
+                       "\": must be a non-empty word without spaces or slashes");
+    s.description = in.text("description", fallback_text("description"));
+    s.max_attempts = static_cast<int>(
+        in.integer("max_attempts", range_of("max_attempts"), fallback_integer("max_attempts")));
+    if (in.has("fidelity")) s.fidelity = in.text("fidelity");
+    in.object("base", true);  // checked to be an object; contents are the worker's business
+    in.object("axes", true);
+    flocsim::input::InputReader slurm = in.object("slurm");
+    s.slurm.runs_per_task = static_cast<int>(slurm.integer(
+        "runs_per_task", range_of("slurm.runs_per_task"), fallback_integer("slurm.runs_per_task")));
+    s.slurm.time_limit = slurm.text("time_limit", fallback_text("slurm.time_limit"));
+    s.slurm.partition = slurm.text("partition", fallback_text("slurm.partition"));
+    s.slurm.gres = slurm.text("gres", fallback_text("slurm.gres"));
+    // both go into the job script's #SBATCH lines: one word each, so that no
+    // value can end a line and start a shell command there
+    for (const auto& [field, value] :
+         {std::pair<std::string, std::string>{"slurm.time_limit", s.slurm.time_limit},
+          {"slurm.partition", s.slurm.partition},
+          {"slurm.gres", s.slurm.gres}})
+      if (value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                  "0123456789:-_.,") != std::string::npos)
+        throw InputError(field + " = " + flocsim::input::shown(value) +
+                         ": must be one word of letters, digits and : - _ . , (Slurm's syntax)");
+    // read here, when the sweep is read: "abc" went to sbatch after the sweep
+    // was registered, twenty digits stopped the plan with "error: stol"
+    if (!slurm_time_limit_s(s.slurm.time_limit) && s.slurm.time_limit != "UNLIMITED" &&
+        s.slurm.time_limit != "INFINITE")
+      throw InputError("slurm.time_limit = " + flocsim::input::shown(s.slurm.time_limit) +
+                       ": not a Slurm time limit; allowed: MINUTES, MINUTES:SECONDS, "
+                       "HOURS:MINUTES:SECONDS, DAYS-HOURS, DAYS-HOURS:MINUTES, "
+                       "DAYS-HOURS:MINUTES:SECONDS (numbers of at most 9 digits) or UNLIMITED");
+    s.slurm.max_parallel = static_cast<int>(slurm.integer(
+        "max_parallel", range_of("slurm.max_parallel"), fallback_integer("slurm.max_parallel")));
+    s.slurm.cpus_per_task = static_cast<int>(slurm.integer(
+        "cpus_per_task", range_of("slurm.cpus_per_task"), fallback_integer("slurm.cpus_per_task")));
+    slurm.finish();
+    in.finish();
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  s.base = s.source["base"];
+  if (s.fidelity) {
+    if (s.base.contains("fidelity"))
+      throw InputError(where + ": fidelity is given both at the top level (\"" + *s.fidelity +
+                       "\") and in base.fidelity (" + describe(s.base["fidelity"]) +
+                       "); give it once");
+    s.base["fidelity"] = *s.fidelity;
+  }
+  read_axes(file, where, s);
   return s;
 }
 

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libsqlite3-dev sqlite3 libhdf5-dev hdf5-tools
   nlohmann-json3-dev libgtest-dev libgmock-dev libcli11-dev
   gnuplot-nox
+  python3-jsonschema
 )
 # Slurm, the orchestrator's backend for sweeps that outgrow one machine; the
 # tests start a private single-node Slurm from these packages. Skip them with

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <sstream>
 
+#include "engine/case/case_fields.hpp"
 #include "engine/case/case_support.hpp"
 #include "engine/case/scene.hpp"
 #include "engine/input/input_reader.hpp"
@@ -41,95 +42,104 @@ double cell_noise(unsigned seed, long cell, int component) {
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 
-}  // namespace
-
-FluidCase parse_fluid_case(const nlohmann::json& document) {
-  FluidCase c;
-  InputReader root(document, "");
-  root.choice("scene", {std::string(scene_name(Scene::fluid))});
-  c.precision = root.choice("precision", {"double", "float"}, "double") == "float"
-                    ? Precision::single_precision
-                    : Precision::double_precision;
-  parse_device_name(root.choice("device", {"cpu", "cuda"}, "cpu"), c.device);
-
-  InputReader fluid = root.object("fluid", true);
-  const auto size = fluid.numbers("size", 3, {.at_least = 1, .at_most = 4096});
-  for (int d = 0; d < 3; ++d)
-    if (size[d] != std::floor(size[d]))
-      throw InputError(fluid.field("size") + "[" + std::to_string(d) +
-                       "] = " + format_value(size[d]) + ": must be a whole number of cells");
-  c.size = {static_cast<int>(size[0]), static_cast<int>(size[1]), static_cast<int>(size[2])};
-  c.relaxation.viscosity = fluid.number(
-      "viscosity", {.above = 0, .at_most = 1, .why = "(tau = 3 nu + 1/2 must exceed 1/2)"});
-  c.relaxation.magic_lambda = fluid.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
-  if (c.relaxation.viscosity < kSmallestTestedViscosity)
-    c.warnings.push_back(fluid.field("viscosity") + " = " + format_value(c.relaxation.viscosity) +
-                         " is below the smallest viscosity the solver is tested at (" +
-                         format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
-  const Range force_range{.at_least = -0.01, .at_most = 0.01};
-  const auto f = fluid.numbers("body_force", 3, force_range, std::vector<double>{0, 0, 0});
-  c.body_force = {f[0], f[1], f[2]};
-
+// fluid.initial: the type, the uniform flow added to it and its wave. The
+// wave's fields apply to the wave types only: given with another type they
+// are refused naming the type.
+void read_initial_field(InputReader& fluid, FluidCase& c) {
   InputReader init = fluid.object("initial");
   InitialField& in = c.initial;
-  in.type = init.choice("type", {"rest", "uniform", "shear_wave", "taylor_green"}, "rest");
-  const Range speed{.at_least = -kMaxLatticeSpeed,
-                    .at_most = kMaxLatticeSpeed,
-                    .why = "(Mach limit |u| <= 0.2 c_s)"};
-  const auto u = init.numbers("velocity", 3, speed, std::vector<double>{0, 0, 0});
+  in.type = case_choice(init, "type");
+  const auto u = init.numbers("velocity", 3, case_field("fluid.initial.velocity").range,
+                              std::vector<double>{0, 0, 0});
   in.mean_velocity = {u[0], u[1], u[2]};
   const bool wave = in.type == "shear_wave" || in.type == "taylor_green";
+  auto only_for = [&](const char* key, bool applies, const char* types) {
+    if (!applies && init.has(key))
+      throw InputError(init.field(key) + ": only with " + init.field("type") + " " + types +
+                       " (type = \"" + in.type + "\")");
+  };
+  only_for("amplitude", wave, "\"shear_wave\" or \"taylor_green\"");
+  only_for("wavelengths", wave, "\"shear_wave\" or \"taylor_green\"");
+  only_for("axis", in.type == "shear_wave", "\"shear_wave\"");
+  only_for("component", in.type == "shear_wave", "\"shear_wave\"");
+  only_for("plane", in.type == "taylor_green", "\"taylor_green\"");
   if (wave) {
-    in.amplitude = init.number(
-        "amplitude",
-        {.at_least = 0, .at_most = kMaxLatticeSpeed, .why = "(Mach limit |u| <= 0.2 c_s)"});
-    in.wavelengths =
-        static_cast<int>(init.integer("wavelengths", {.at_least = 1, .at_most = 1024}, 1));
+    in.amplitude = case_number(init, "amplitude");
+    in.wavelengths = static_cast<int>(case_integer(init, "wavelengths"));
   }
   if (in.type == "shear_wave") {
-    in.axis = axis_index(init.choice("axis", {"x", "y", "z"}, "x"));
-    in.component = axis_index(init.choice("component", {"x", "y", "z"}, "y"));
+    in.axis = axis_index(case_choice(init, "axis"));
+    in.component = axis_index(case_choice(init, "component"));
     if (in.component == in.axis)
       throw InputError(init.field("component") + " = \"" + kAxisNames[in.component] +
                        "\": must differ from " + init.field("axis") +
                        " (a shear wave is transverse)");
   }
   if (in.type == "taylor_green") {
-    const std::string plane = init.choice("plane", {"xy", "yz", "zx"}, "xy");
+    const std::string plane = case_choice(init, "plane");
     in.plane_first = axis_index(plane.substr(0, 1));
     in.plane_second = axis_index(plane.substr(1, 1));
   }
-  in.noise = init.number("noise", {.at_least = 0, .at_most = kMaxLatticeSpeed}, 0.0);
-  in.seed =
-      static_cast<unsigned>(init.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
+  in.noise = case_number(init, "noise");
+  in.seed = static_cast<unsigned>(case_integer(init, "seed"));
   init.finish();
-  fluid.finish();
+}
 
-  // Resolution of the initial mode: at least 4 cells per wavelength.
-  auto check_resolution = [&](int axis) {
+// The initial wave's resolution: at least 4 cells per wavelength.
+void check_wave_resolution(const FluidCase& c) {
+  const InitialField& in = c.initial;
+  auto check = [&](int axis) {
     const int n = extent_along(c.size, axis);
     if (n < 4 * in.wavelengths)
-      throw InputError(
-          fluid.field("size") + "[" + std::to_string(axis) + "] = " + std::to_string(n) +
-          ": must be >= 4 x fluid.initial.wavelengths = " + std::to_string(4 * in.wavelengths) +
-          " to resolve the initial wave");
+      throw InputError("fluid.size[" + std::to_string(axis) + "] = " + std::to_string(n) +
+                       ": must be >= 4 x fluid.initial.wavelengths = " +
+                       std::to_string(4 * in.wavelengths) + " to resolve the initial wave");
   };
-  if (in.type == "shear_wave") check_resolution(in.axis);
+  if (in.type == "shear_wave") check(in.axis);
   if (in.type == "taylor_green") {
-    check_resolution(in.plane_first);
-    check_resolution(in.plane_second);
+    check(in.plane_first);
+    check(in.plane_second);
   }
+}
 
+// fluid: size, viscosity, trt_magic, body_force and the initial field.
+void read_fluid(InputReader& root, FluidCase& c) {
+  InputReader fluid = root.object("fluid", true);
+  const auto size = fluid.numbers("size", 3, case_field("fluid.size").range);
+  for (int d = 0; d < 3; ++d)
+    if (size[d] != std::floor(size[d]))
+      throw InputError(fluid.field("size") + "[" + std::to_string(d) +
+                       "] = " + exact_value(size[d]) + ": must be a whole number of cells");
+  c.size = {static_cast<int>(size[0]), static_cast<int>(size[1]), static_cast<int>(size[2])};
+  c.relaxation.viscosity = case_number(fluid, "viscosity");
+  c.relaxation.magic_lambda = case_number(fluid, "trt_magic");
+  if (c.relaxation.viscosity < kSmallestTestedViscosity)
+    c.warnings.push_back(fluid.field("viscosity") + " = " + exact_value(c.relaxation.viscosity) +
+                         " is below the smallest viscosity the solver is tested at (" +
+                         format_value(kSmallestTestedViscosity) + ", tau = 0.515)");
+  const auto f = fluid.numbers("body_force", 3, case_field("fluid.body_force").range,
+                               std::vector<double>{0, 0, 0});
+  c.body_force = {f[0], f[1], f[2]};
+  read_initial_field(fluid, c);
+  fluid.finish();
+  check_wave_resolution(c);
+}
+
+void read_run_control(InputReader& root, FluidCase& c) {
   InputReader run = root.object("run");
-  c.run.steps = run.integer("steps", {.at_least = 0, .at_most = 1e12}, 1000);
-  c.run.progress_every_s = run.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
-  c.run.checkpoint_every_s = run.number("checkpoint_every_s", {.above = 0}, 600.0);
-  c.run.write_fields = run.boolean("write_fields", false);
-  c.run.fields_every = run.integer("fields_every", {.at_least = 0}, 0);
-  c.run.threads = static_cast<int>(run.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
+  c.run.steps = case_integer(run, "steps");
+  c.run.progress_every_s = case_number(run, "progress_every_s");
+  c.run.checkpoint_every_s = case_number(run, "checkpoint_every_s");
+  c.run.write_fields = case_boolean(run, "write_fields");
+  c.run.fields_every = case_integer(run, "fields_every");
+  c.run.threads = static_cast<int>(case_integer(run, "threads"));
   run.finish();
-  root.finish();
+}
 
+// The Mach limit for the initial field and for the mean flow the body force
+// builds up, and the memory the populations need.
+void check_fluid_limits(const FluidCase& c) {
+  const InitialField& in = c.initial;
   // The largest speed the initial field reaches (mean + wave + noise along a
   // component, bounded by the Euclidean sum) must respect the Mach limit.
   const double mean = std::hypot(in.mean_velocity.x, in.mean_velocity.y, in.mean_velocity.z);
@@ -147,8 +157,8 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
   const double fmag = std::hypot(c.body_force.x, c.body_force.y, c.body_force.z);
   const double final_mean = mean + fmag * static_cast<double>(c.run.steps);
   if (fmag > 0 && final_mean > kMaxLatticeSpeed)
-    throw InputError("fluid.body_force = [" + format_value(c.body_force.x) + ", " +
-                     format_value(c.body_force.y) + ", " + format_value(c.body_force.z) +
+    throw InputError("fluid.body_force = [" + exact_value(c.body_force.x) + ", " +
+                     exact_value(c.body_force.y) + ", " + exact_value(c.body_force.z) +
                      "]: accelerates the mean flow to |u| = " + format_value(final_mean) +
                      " after run.steps = " + std::to_string(c.run.steps) +
                      "; must stay <= " + format_value(kMaxLatticeSpeed) +
@@ -163,6 +173,23 @@ FluidCase parse_fluid_case(const nlohmann::json& document) {
                      format_value(bytes / 1e9) +
                      " GB for the populations; must fit in 80 % of this machine's " +
                      format_value(available / 1e9) + " GB");
+}
+
+}  // namespace
+
+FluidCase parse_fluid_case(const nlohmann::json& document) {
+  FluidCase c;
+  InputReader root(document, "");
+  root.choice("scene", {std::string(scene_name(Scene::fluid))});
+  // every field against its declaration: unknown, unused in this scene, type, range
+  c.warnings = input::check_fields(case_field_table(), document, scene_context(Scene::fluid));
+  c.precision = case_choice(root, "precision") == "float" ? Precision::single_precision
+                                                          : Precision::double_precision;
+  parse_device_name(case_choice(root, "device"), c.device);
+  read_fluid(root, c);
+  read_run_control(root, c);
+  root.finish();
+  check_fluid_limits(c);
   return c;
 }
 

@@ -8,6 +8,7 @@
 #include "engine/calibration/hydrodynamic_radius.hpp"
 #include "engine/calibration/pair_resistance.hpp"
 #include "engine/calibration/table_scheme.hpp"
+#include "engine/case/case_fields.hpp"
 #include "engine/case/case_support.hpp"
 #include "engine/case/fluid_case.hpp"
 #include "engine/input/input_reader.hpp"
@@ -285,29 +286,58 @@ double settling_velocity_at_multi_sweep_floor(const SuspensionCase& c) {
 }
 }  // namespace
 
-SuspensionCase parse_suspension_case(const nlohmann::json& document) {
+namespace {
+
+// One reading of a case: what has been read so far, the fidelity preset's
+// values, how the velocity scale was given and the immersed-boundary options
+// as written (messages that show a scheme mark the fields it leaves out).
+struct Reading {
   SuspensionCase c;
-  InputReader root(document, "");
-  c.scene = scene_from_name(root.choice("scene", scene_names(/*with_spheres=*/true)));
-  c.fidelity = root.choice("fidelity", {"draft", "standard", "paper"}, "standard");
-  const Preset p = preset(c.fidelity);
-  c.numerics.single_precision = root.choice("precision", {"double", "float"}, "double") == "float";
+  Preset p{};
+  bool has_nu = false, has_u = false;
+  nlohmann::json ib_given = nlohmann::json::object();
+};
+
+bool has_liquid(const SuspensionCase& c) {
+  return modules_of(c.scene).liquid;
+}
+
+// The largest U_inf: the Mach limit with a liquid, the sphere speed check's
+// margin without (suspension_case.hpp).
+double largest_settling_velocity(const SuspensionCase& c) {
+  return has_liquid(c) ? kMaxSettlingVelocity : kMaxSettlingVelocityWithoutLiquid;
+}
+
+std::string largest_settling_velocity_why(const SuspensionCase& c) {
+  return has_liquid(c) ? "(Mach limit for settling flows)"
+                       : "(a scene without liquid starts Maxwellian with U_inf per component; the "
+                         "runs' sphere speed check, 0.3 per step, must stay 6 U_inf away)";
+}
+
+std::string stable_why(double a) {
+  return "(the smallest viscosity the coupled solver is measured stable at with a_over_dx = " +
+         format_value(a) + "; docs/numerics.md)";
+}
+
+// scene (read by the caller), fidelity, precision, device, seed
+void read_identity(InputReader& root, SuspensionCase& c) {
+  c.fidelity = case_choice(root, "fidelity");
+  c.numerics.single_precision = case_choice(root, "precision") == "float";
   // On a GPU the lattice and the immersed boundary run there (docs/gpu.md);
-  // which scenes and couplings can is checked once the coupling is known.
-  parse_device_name(root.choice("device", {"cpu", "cuda"}, "cpu"), c.device);
+  // which couplings can is checked once the coupling is known (read_coupling_choice).
+  parse_device_name(case_choice(root, "device"), c.device);
   if (c.device == Device::cuda && !modules_of(c.scene).liquid)
     throw InputError(root.field("device") + " = \"cuda\": scene \"" +
                      std::string(scene_name(c.scene)) +
                      "\" has no liquid, and the GPU runs the lattice; give \"cpu\" or leave the "
                      "field out");
-  c.seed =
-      static_cast<std::uint64_t>(root.integer("seed", {.at_least = 0, .at_most = 4294967295.0}, 1));
+  c.seed = static_cast<std::uint64_t>(case_integer(root, "seed"));
+}
 
-  const bool single = c.scene == Scene::single_sphere;
+// positions_from and positions_from_box (fixed-array only: check_fields
+// refuses them elsewhere).
+void read_positions_source(InputReader& root, SuspensionCase& c) {
   if (root.has("positions_from")) {
-    if (c.scene != Scene::fixed_array)
-      throw InputError("positions_from: only for scene \"fixed-array\" (scene = \"" +
-                       std::string(scene_name(c.scene)) + "\")");
     if (root.has("phi"))
       throw InputError(
           "phi and positions_from: give one; with positions_from the snapshot sets N and phi");
@@ -316,7 +346,8 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       throw InputError(
           "positions_from = \"\": must name a sphere snapshot file (spheres/step_N.h5 of a run)");
     if (root.has("positions_from_box")) {
-      c.positions_from_box = root.numbers("positions_from_box", 3, {.at_least = 1, .at_most = 1e5});
+      c.positions_from_box =
+          root.numbers("positions_from_box", 3, case_field("positions_from_box").range);
       for (double n : c.positions_from_box)
         if (n != std::round(n))
           throw InputError("positions_from_box = [" + box_text(c.positions_from_box) +
@@ -325,366 +356,401 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   } else if (root.has("positions_from_box")) {
     throw InputError("positions_from_box: only with positions_from (the box of its snapshot)");
   }
-  if (!single && c.positions_from.empty())
-    c.physics.phi = root.number(
-        "phi", {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"});
-  c.physics.reynolds_inf = root.number("Re_inf", {.above = 0, .at_most = 200}, 12.0);
-  c.physics.density_ratio = root.number(
-      "density_ratio", {.above = 1, .at_most = 100, .why = "(spheres must settle)"}, 4.0);
-  c.physics.du_over_uinf = root.number("du_over_Uinf", {.at_least = 0, .at_most = 0.5}, 0.0);
-  c.physics.delta_over_a = root.number("delta_over_a", {.above = 0, .at_most = 0.5}, 0.025);
-  c.physics.restitution = root.number("restitution", {.at_least = 0, .at_most = 1}, 1.0);
-  c.physics.friction = root.number("friction", {.at_least = 0, .at_most = 10}, 0.0);
-  c.physics.lubrication_model =
-      root.choice("lubrication_model", {"calibrated", "nguyen-ladd"}, "calibrated");
-  c.physics.lubrication_integration =
-      root.choice("lubrication_integration", {"implicit", "explicit-paper"}, "implicit");
-  // A scene without lubrication runs no model: one named there (a suspension's
-  // case reused for its fixed array) is not recorded as if it had run.
-  if (!modules_of(c.scene).lubrication)
-    for (const char* key : {"lubrication_model", "lubrication_integration"})
-      if (root.has(key))
-        c.warnings.push_back(std::string(key) + ": scene \"" + std::string(scene_name(c.scene)) +
-                             "\" has no lubrication, so no model runs; not recorded");
-  c.physics.lubrication_onset_over_a =
-      root.number("lubrication_onset_over_a", {.above = 0, .at_most = 1}, 0.2);
-  c.physics.lubrication_saturation_over_a =
-      root.number("lubrication_saturation_over_a",
-                  {.above = 0,
-                   .below = c.physics.lubrication_onset_over_a,
-                   .why = "(below lubrication_onset_over_a)"},
-                  2e-4);
-  c.physics.length_over_a =
-      root.number("L_over_a", {.at_least = 8, .at_most = 256}, p.length_over_a);
-  c.physics.length_over_width = root.number("L_over_W", {.at_least = 0.25, .at_most = 8}, 2.0);
+}
 
-  InputReader num = root.object("numerics");
-  c.numerics.radius_cells = num.number("a_over_dx", {.at_least = 3, .at_most = 24}, p.radius_cells);
-  const bool has_nu = num.has("viscosity"), has_u = num.has("U_inf");
-  if (has_nu && has_u)
+// The top-level physics: phi, the dimensionless groups, contacts, lubrication, box shape.
+void read_physics(InputReader& root, SuspensionCase& c, const Preset& p) {
+  if (c.scene != Scene::single_sphere && c.positions_from.empty())
+    c.physics.phi = case_number(root, "phi");
+  c.physics.reynolds_inf = case_number(root, "Re_inf");
+  c.physics.density_ratio = case_number(root, "density_ratio");
+  c.physics.du_over_uinf = case_number(root, "du_over_Uinf");
+  c.physics.delta_over_a = case_number(root, "delta_over_a");
+  c.physics.restitution = case_number(root, "restitution");
+  c.physics.friction = case_number(root, "friction");
+  // a scene without lubrication runs no model and records none (check_fields
+  // warns where one is given: a suspension's case reused for its fixed array)
+  c.physics.lubrication_model = case_choice(root, "lubrication_model");
+  c.physics.lubrication_integration = case_choice(root, "lubrication_integration");
+  c.physics.lubrication_onset_over_a = case_number(root, "lubrication_onset_over_a");
+  c.physics.lubrication_saturation_over_a =
+      case_number(root, "lubrication_saturation_over_a",
+                  Range{.above = 0,
+                        .below = c.physics.lubrication_onset_over_a,
+                        .why = "(below lubrication_onset_over_a)"});
+  c.physics.length_over_a = case_number(root, "L_over_a", std::nullopt, p.length_over_a);
+  c.physics.length_over_width = case_number(root, "L_over_W");
+}
+
+// The viscosity ceiling (kLargestViscosity), one rule for a viscosity given
+// directly (its range, case_fields.cpp) and one implied by Re_inf and a given
+// U_inf: nu = 2 a U_inf / Re_inf has no upper bound as Re_inf falls (Re_inf
+// 0.01 at draft: nu 56), and such runs blew up with hints that the viscosity
+// was too small. Refused before any work, naming the implied viscosity and the
+// U_inf that brings it to the ceiling. (Without a U_inf given, the preset's is
+// lowered onto the ceiling instead, as it is raised onto the stability floor.)
+void check_viscosity_ceiling(const Reading& r) {
+  const SuspensionCase& c = r.c;
+  // (rounding allowed: Re_inf 2.8 with U_inf 0.07 at a = 4 is on the ceiling)
+  if (!has_liquid(c) || c.numerics.viscosity <= kLargestViscosity * (1 + 1e-12)) return;
+  const double a = c.numerics.radius_cells;
+  const double u_works = c.physics.reynolds_inf * kLargestViscosity / (2 * a);
+  throw InputError(
+      "Re_inf = " + exact_value(c.physics.reynolds_inf) + " with numerics.U_inf = " +
+      exact_value(c.derived.settling_velocity) + " and a_over_dx = " + exact_value(a) +
+      " implies numerics.viscosity = 2 a U_inf / Re_inf = " + format_value(c.numerics.viscosity) +
+      ", above the largest accepted (" + format_value(kLargestViscosity) +
+      "; docs/numerics.md, \"Viscosity ceiling\")" +
+      "; give numerics.U_inf <= " + format_value(u_works) +
+      " (or numerics.viscosity <= " + format_value(kLargestViscosity) + "), or a larger Re_inf");
+}
+
+// numerics.a_over_dx and the velocity scale: numerics.viscosity or
+// numerics.U_inf (never both), or the preset's U_inf, moved onto the stability
+// floor where it would imply a viscosity below it.
+void read_velocity_scale(InputReader& num, Reading& r) {
+  SuspensionCase& c = r.c;
+  c.numerics.radius_cells = case_number(num, "a_over_dx", std::nullopt, r.p.radius_cells);
+  r.has_nu = num.has("viscosity");
+  r.has_u = num.has("U_inf");
+  if (r.has_nu && r.has_u)
     throw InputError(
         "numerics: give either numerics.viscosity or numerics.U_inf, not both (each fixes the "
         "other through Re_inf)");
   const double a = c.numerics.radius_cells;
   const double nu_min = smallest_stable_viscosity(a);
-  // the largest U_inf: the Mach limit with a liquid, the sphere speed check's
-  // margin without (suspension_case.hpp)
-  const bool liquid = modules_of(c.scene).liquid;
-  const double largest_u = liquid ? kMaxSettlingVelocity : kMaxSettlingVelocityWithoutLiquid;
-  const std::string largest_u_why =
-      liquid ? "(Mach limit for settling flows)"
-             : "(a scene without liquid starts Maxwellian with U_inf per component; the "
-               "runs' sphere speed check, 0.3 per step, must stay 6 U_inf away)";
-  const std::string stable_why =
-      "(the smallest viscosity the coupled solver is measured stable at "
-      "with a_over_dx = " +
-      format_value(a) + "; docs/numerics.md)";
-  if (has_nu) {
+  if (r.has_nu) {
     c.numerics.viscosity =
-        num.number("viscosity", {.at_least = nu_min, .at_most = 1, .why = stable_why});
+        case_number(num, "viscosity",
+                    Range{.at_least = nu_min, .at_most = kLargestViscosity, .why = stable_why(a)});
     c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
-  } else {
-    const Range u_range{.above = 0, .at_most = largest_u, .why = largest_u_why};
-    c.derived.settling_velocity =
-        num.number("U_inf", u_range, liquid ? p.settling_velocity : kSettlingVelocityWithoutLiquid);
-    c.numerics.viscosity = c.derived.settling_velocity * 2 * a / c.physics.reynolds_inf;
-    // The ceiling of a viscosity given directly holds for one implied by U_inf:
-    // nu = 2 a U_inf / Re_inf has no upper bound as Re_inf falls (Re_inf 0.01
-    // at draft: nu 56), and such runs blew up with hints that the viscosity
-    // was too small. Refused before any work, with the U_inf that keeps nu in range.
-    constexpr double kLargestViscosity = 1;  // numerics.viscosity's own limit (above)
-    if (liquid && c.numerics.viscosity > kLargestViscosity) {
-      const double u_works = c.physics.reynolds_inf * kLargestViscosity / (2 * a);
-      throw InputError("Re_inf = " + format_value(c.physics.reynolds_inf) +
-                       " with numerics.U_inf = " + format_value(c.derived.settling_velocity) +
-                       (has_u ? "" : " (the " + c.fidelity + " preset's)") + " and a_over_dx = " +
-                       format_value(a) + " implies numerics.viscosity = 2 a U_inf / Re_inf = " +
-                       format_value(c.numerics.viscosity) + ", above the largest accepted (" +
-                       format_value(kLargestViscosity) +
-                       "); give numerics.U_inf <= " + format_value(u_works) +
-                       " (or numerics.viscosity <= " + format_value(kLargestViscosity) +
-                       "), or a larger Re_inf");
-    }
-    // by default stay inside the stable viscosity range: raise U_inf instead
-    if (!has_u && c.numerics.viscosity < nu_min) {
-      c.numerics.viscosity = nu_min;
-      c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
-    }
+    return;
   }
-  c.numerics.trt_magic = num.number("trt_magic", {.above = 0, .at_most = 10}, 0.25);
-  c.numerics.inside_liquid = num.choice("inside_liquid", {"measured", "rigid-body"}, "measured");
-  if (c.numerics.inside_liquid != "measured" &&
-      !(modules_of(c.scene).liquid && modules_of(c.scene).spheres_move))
-    throw InputError("numerics.inside_liquid = \"" + c.numerics.inside_liquid + "\": scene \"" +
-                     std::string(scene_name(c.scene)) +
-                     "\" has no spheres moving in a liquid; only the default \"measured\" applies");
-  {
-    // The preset's option where it is validated for this phi (a snapshot's phi
-    // is only known later: the paper's method then) and calibrated for this a
-    // within a factor 2 of this viscosity, else the paper's method. So does a
-    // scene with the calibrated close-pair model where the option's close-pair
-    // resistance has not been measured at this a within a factor 2 of nu but
-    // the paper method's is nearer (where neither is, the faster one runs,
-    // with the same warning).
-    const auto& radii = calibration::CalibrationTable::shipped();
-    auto calibrated_near = [&](const coupling::Scheme& scheme) {
-      return radii.has(a, scheme) &&
-             std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
-                               c.numerics.viscosity)) <= std::log(kNearViscosityFactor);
-    };
-    auto pair_gap = [&](const coupling::Scheme& scheme) {
-      return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
-                                                                       scheme);
-    };
-    auto choose_scheme = [&] {
-      coupling::Scheme preset_scheme = p.coupling;
-      if (!c.positions_from.empty() ||
-          c.physics.phi > coupling::largest_validated_phi(preset_scheme) ||
-          !calibrated_near(preset_scheme) ||
-          (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
-           pair_gap(preset_scheme) > kNearViscosityFactor &&
-           pair_gap(coupling::kPaperScheme) < pair_gap(preset_scheme)))
-        preset_scheme = coupling::kPaperScheme;
-      return read_coupling(num, preset_scheme);
-    };
-    c.numerics.coupling = choose_scheme();
-    // A scene without liquid couples nothing: the options are read (and
-    // checked) but no scheme runs and none is recorded, as for the
-    // lubrication options of a scene without lubrication; said, not silent.
-    if (!modules_of(c.scene).liquid)
-      for (const char* key : {"coupling", "immersed_boundary"})
-        if (num.has(key))
-          c.warnings.push_back(std::string("numerics.") + key + ": scene \"" +
-                               std::string(scene_name(c.scene)) +
-                               "\" has no liquid, so no coupling runs; not recorded (leave it out: "
-                               "in a sweep it still changes the run's id)");
-    // By default also stay clear of the multi-sweep coupling's oscillation
-    // (below): raise U_inf until nu reaches its floor, where the Mach limit
-    // allows, and choose again at that viscosity.
-    if (!has_nu && !has_u && multi_sweep_oscillates(c)) {
-      const double u = settling_velocity_at_multi_sweep_floor(c);
-      if (u <= kMaxSettlingVelocity) {
-        c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
-        c.derived.settling_velocity = u;
-        c.numerics.coupling = choose_scheme();
-      }
+  const Range u_range{
+      .above = 0, .at_most = largest_settling_velocity(c), .why = largest_settling_velocity_why(c)};
+  c.derived.settling_velocity =
+      case_number(num, "U_inf", u_range,
+                  has_liquid(c) ? r.p.settling_velocity : kSettlingVelocityWithoutLiquid);
+  c.numerics.viscosity = c.derived.settling_velocity * 2 * a / c.physics.reynolds_inf;
+  // by default stay inside the stable viscosity range: lower U_inf onto the
+  // viscosity ceiling (a low Re_inf with the preset's U_inf), or raise it onto
+  // the stability floor; a U_inf given is never moved, but refused
+  if (!r.has_u && has_liquid(c) && c.numerics.viscosity > kLargestViscosity * (1 + 1e-12)) {
+    c.numerics.viscosity = kLargestViscosity;
+    c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
+  }
+  check_viscosity_ceiling(r);
+  if (!r.has_u && c.numerics.viscosity < nu_min) {
+    c.numerics.viscosity = nu_min;
+    c.derived.settling_velocity = c.physics.reynolds_inf * c.numerics.viscosity / (2 * a);
+  }
+}
+
+// The coupling: the preset's option where it is validated for this phi (a
+// snapshot's phi is only known later: the paper's method then) and calibrated
+// for this a within a factor 2 of this viscosity, else the paper's method. So
+// does a scene with the calibrated close-pair model where the option's
+// close-pair resistance has not been measured at this a within a factor 2 of
+// nu but the paper method's is nearer (where neither is, the faster one runs,
+// with the same warning). Then the case's own numerics options on top.
+coupling::Scheme choose_scheme(InputReader& num, const Reading& r) {
+  const SuspensionCase& c = r.c;
+  const double a = c.numerics.radius_cells;
+  const auto& radii = calibration::CalibrationTable::shipped();
+  auto calibrated_near = [&](const coupling::Scheme& scheme) {
+    return radii.has(a, scheme) &&
+           std::abs(std::log(radii.lookup(a, c.numerics.viscosity, scheme).viscosity /
+                             c.numerics.viscosity)) <= std::log(kNearViscosityFactor);
+  };
+  auto pair_gap = [&](const coupling::Scheme& scheme) {
+    return calibration::PairResistanceTable::shipped().viscosity_gap(a, c.numerics.viscosity,
+                                                                     scheme);
+  };
+  coupling::Scheme preset_scheme = r.p.coupling;
+  if (!c.positions_from.empty() || c.physics.phi > coupling::largest_validated_phi(preset_scheme) ||
+      !calibrated_near(preset_scheme) ||
+      (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated" &&
+       pair_gap(preset_scheme) > kNearViscosityFactor &&
+       pair_gap(coupling::kPaperScheme) < pair_gap(preset_scheme)))
+    preset_scheme = coupling::kPaperScheme;
+  return read_coupling(num, preset_scheme);
+}
+
+// trt_magic, inside_liquid and the coupling scheme. A scene without liquid
+// couples nothing: its options are read (and checked) but no scheme runs and
+// none is recorded (check_fields warns).
+void read_scheme(InputReader& num, Reading& r) {
+  SuspensionCase& c = r.c;
+  c.numerics.trt_magic = case_number(num, "trt_magic");
+  c.numerics.inside_liquid = case_choice(num, "inside_liquid");
+  if (!has_liquid(c)) {
+    // no coupling runs: its options (checked and warned about by
+    // check_fields) are not read, and no rule between them applies
+    case_choice(num, "coupling");
+    num.object("immersed_boundary");
+    c.numerics.coupling = r.p.coupling;
+    return;
+  }
+  c.numerics.coupling = choose_scheme(num, r);
+  // By default also stay clear of the multi-sweep coupling's oscillation
+  // (check_multi_sweep_floor): raise U_inf until nu reaches its floor, where
+  // the Mach limit allows, and choose again at that viscosity.
+  if (!r.has_nu && !r.has_u && multi_sweep_oscillates(c)) {
+    const double u = settling_velocity_at_multi_sweep_floor(c);
+    if (u <= kMaxSettlingVelocity) {
+      c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
+      c.derived.settling_velocity = u;
+      c.numerics.coupling = choose_scheme(num, r);
     }
   }
   if (c.device == Device::cuda && !c.numerics.coupling.immersed_boundary())
     throw InputError("device = \"cuda\" with numerics.coupling = \"partially-saturated\": "
                      "partially saturated cells do not run on the GPU yet (docs/gpu.md); give "
                      "numerics.coupling = \"immersed-boundary\" or device \"cpu\"");
-  // numerics.immersed_boundary as the case file writes it, for messages that
-  // show the scheme: a field it leaves out is marked as the default
-  const nlohmann::json ib_given =
-      document.contains("numerics") && document["numerics"].contains("immersed_boundary")
-          ? document["numerics"]["immersed_boundary"]
-          : nlohmann::json::object();
-  // A scheme asked for beyond the phi it is validated for is refused for that
-  // (below) before its calibration is looked for: one sweep at phi 0.3 is not
-  // to be calibrated but replaced.
-  auto refuse_beyond_validated_phi = [&] {
-    if (c.positions_from.empty() &&
-        c.physics.phi > coupling::largest_validated_phi(c.numerics.coupling))
-      throw beyond_validated_phi(c.numerics.coupling, ib_given, c.physics.phi);
-  };
+}
+
+// numerics.input_radius: where each scheme puts its boundary relative to its
+// input radius (the shipped-table test checks the calibrated offsets against
+// the same).
+void read_input_radius(InputReader& num, SuspensionCase& c) {
   c.numerics.input_radius_given = num.has("input_radius");
-  if (c.numerics.input_radius_given) {
-    // where each scheme puts its boundary relative to its input radius (the
-    // shipped-table test checks the calibrated offsets against the same)
-    const coupling::Scheme& s = c.numerics.coupling;
-    const Range range =
-        !s.immersed_boundary()
-            ? Range{.at_least = a - 0.5,
-                    .at_most = a + 0.5,
-                    .why =
-                        "(partially saturated cells' boundary lies within half a cell of the "
-                        "covered sphere's)"}
-        : s.control()
-            ? Range{.at_least = a - 1.5,
-                    .at_most = a,
-                    .why =
-                        "(control forcing's wall lies up to the kernel's half-width, 1.5 dx, "
-                        "outside its markers)"}
-            : Range{.at_least = a - 1,
-                    .at_most = a,
-                    .why =
-                        "(markers sit inside the hydrodynamic radius a_over_dx, by less than "
-                        "1 dx)"};
-    c.numerics.input_radius = num.number("input_radius", range);
+  if (!c.numerics.input_radius_given) return;
+  if (!has_liquid(c)) {  // no markers: the field's own range only (check_fields warns)
+    c.numerics.input_radius = case_number(num, "input_radius");
+    return;
   }
-  num.finish();
-  // Re_inf = 2 a U_inf / nu: with U_inf at the Mach limit and nu at the
-  // stability floor the largest Re_inf grows with a. Where this Re_inf is out
-  // of reach at this a, say so and name the smallest a that reaches it.
+  const double a = c.numerics.radius_cells;
+  const coupling::Scheme& s = c.numerics.coupling;
+  const Range range =
+      !s.immersed_boundary()
+          ? Range{.at_least = a - 0.5,
+                  .at_most = a + 0.5,
+                  .why =
+                      "(partially saturated cells' boundary lies within half a cell of the "
+                      "covered sphere's)"}
+      : s.control()
+          ? Range{.at_least = a - 1.5,
+                  .at_most = a,
+                  .why =
+                      "(control forcing's wall lies up to the kernel's half-width, 1.5 dx, "
+                      "outside its markers)"}
+          : Range{.at_least = a - 1,
+                  .at_most = a,
+                  .why =
+                      "(markers sit inside the hydrodynamic radius a_over_dx, by less than "
+                      "1 dx)"};
+  c.numerics.input_radius = case_number(num, "input_radius", range);
+}
+
+// Re_inf = 2 a U_inf / nu: with U_inf at the Mach limit and nu at the
+// stability floor the largest Re_inf grows with a. Where this Re_inf is out of
+// reach at this a, say so and name the smallest a that reaches it.
+std::string beyond_reach(const SuspensionCase& c) {
+  const double a = c.numerics.radius_cells;
+  const double nu_min = smallest_stable_viscosity(a);
   const double largest_re = 2 * a * kMaxSettlingVelocity / nu_min;
-  auto beyond_reach = [&] {
-    double needed = 24;                              // the largest a_over_dx accepted
-    for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
-      if (calibrated > a &&
-          2 * calibrated * kMaxSettlingVelocity / smallest_stable_viscosity(calibrated) >=
-              c.physics.reynolds_inf) {
-        needed = calibrated;
-        break;
-      }
-    return "at a_over_dx = " + format_value(a) +
-           " the stability floor nu >= " + format_value(nu_min) +
-           " and the Mach limit U_inf <= " + format_value(kMaxSettlingVelocity) +
-           " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) +
-           "; raise numerics.a_over_dx to at least " + format_value(needed) +
-           (a < 6 && needed <= 6 ? " (fidelity standard or paper)" : "") + " or lower Re_inf";
-  };
-  if (c.derived.settling_velocity > largest_u) {
-    const std::string way_out =
-        c.numerics.viscosity <= nu_min ? beyond_reach() : std::string("lower numerics.viscosity");
+  double needed = 24;                              // the largest a_over_dx accepted
+  for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
+    if (calibrated > a &&
+        2 * calibrated * kMaxSettlingVelocity / smallest_stable_viscosity(calibrated) >=
+            c.physics.reynolds_inf) {
+      needed = calibrated;
+      break;
+    }
+  return "at a_over_dx = " + format_value(a) +
+         " the stability floor nu >= " + format_value(nu_min) +
+         " and the Mach limit U_inf <= " + format_value(kMaxSettlingVelocity) +
+         " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) +
+         "; raise numerics.a_over_dx to at least " + format_value(needed) +
+         (a < 6 && needed <= 6 ? " (fidelity standard or paper)" : "") + " or lower Re_inf";
+}
+
+// The Mach cap, for U_inf given, derived from a given viscosity or the preset's.
+void check_mach_cap(const SuspensionCase& c) {
+  const double largest_u = largest_settling_velocity(c);
+  if (c.derived.settling_velocity <= largest_u) return;
+  const double a = c.numerics.radius_cells;
+  const std::string way_out = c.numerics.viscosity <= smallest_stable_viscosity(a)
+                                  ? beyond_reach(c)
+                                  : std::string("lower numerics.viscosity");
+  throw InputError("numerics: U_inf = Re_inf nu / (2a) = " + exact_value(c.physics.reynolds_inf) +
+                   " * " + format_value(c.numerics.viscosity) + " / " + format_value(2 * a) +
+                   " = " + format_value(c.derived.settling_velocity) +
+                   ": must be <= " + format_value(largest_u) + " " +
+                   largest_settling_velocity_why(c) + "; " + way_out);
+}
+
+// The stability floor for a viscosity implied by a given U_inf (a given
+// viscosity is range-checked when read and the default U_inf is raised to stay
+// inside the range, so only an explicit U_inf reaches this).
+void check_stability_floor(const SuspensionCase& c) {
+  const double a = c.numerics.radius_cells;
+  const double nu_min = smallest_stable_viscosity(a);
+  if (c.numerics.viscosity >= nu_min) return;
+  const double largest_re = 2 * a * kMaxSettlingVelocity / nu_min;
+  throw InputError(
+      "numerics.U_inf = " + exact_value(c.derived.settling_velocity) + " with Re_inf = " +
+      exact_value(c.physics.reynolds_inf) + " and a_over_dx = " + format_value(a) +
+      " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.numerics.viscosity) +
+      ": must be >= " + format_value(nu_min) + " " + stable_why(a) + "; " +
+      (c.physics.reynolds_inf > largest_re
+           ? beyond_reach(c)
+           : "raise numerics.U_inf to at least " +
+                 format_value(nu_min * c.physics.reynolds_inf / (2 * a)) + " or leave it out"));
+}
+
+// A scheme asked for beyond the phi it is validated for is refused for that
+// before its calibration is looked for: one sweep at phi 0.3 is not to be
+// calibrated but replaced.
+void refuse_beyond_validated_phi(const Reading& r) {
+  const SuspensionCase& c = r.c;
+  if (c.positions_from.empty() &&
+      c.physics.phi > coupling::largest_validated_phi(c.numerics.coupling))
+    throw beyond_validated_phi(c.numerics.coupling, r.ib_given, c.physics.phi);
+}
+
+// A hand-given a_g replaces the calibration, not the validation: the scheme
+// must still be one the project offers (calibrated at some a).
+void check_offered_scheme(const Reading& r) {
+  const SuspensionCase& c = r.c;
+  const auto& table = calibration::CalibrationTable::shipped();
+  bool offered = false;
+  std::string names;
+  for (const auto& e : table.entries()) {
+    offered = offered || e.scheme.same_calibration(c.numerics.coupling);
+    const std::string n = scheme_fields(e.scheme);
+    if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
+  }
+  if (offered) return;
+  refuse_beyond_validated_phi(r);
+  throw InputError(coupling_field(c.numerics.coupling) + " = " +
+                   scheme_fields(c.numerics.coupling, r.ib_given) +
+                   ": not an offered option (no calibration of it is shipped at any a); "
+                   "offered: " +
+                   names + " (docs/accuracy-cost.md)");
+}
+
+// a_g for this a from the shipped calibration, interpolated in log(nu)
+// between the calibrated viscosities around this one.
+void apply_radius_calibration(Reading& r) {
+  SuspensionCase& c = r.c;
+  if (!has_liquid(c)) return;
+  if (c.numerics.input_radius_given) return check_offered_scheme(r);
+  const double a = c.numerics.radius_cells;
+  const auto& table = calibration::CalibrationTable::shipped();
+  if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling)) {
+    refuse_beyond_validated_phi(r);
     throw InputError(
-        "numerics: U_inf = Re_inf nu / (2a) = " + format_value(c.physics.reynolds_inf) + " * " +
-        format_value(c.numerics.viscosity) + " / " + format_value(2 * a) + " = " +
-        format_value(c.derived.settling_velocity) + ": must be <= " + format_value(largest_u) +
-        " " + largest_u_why + "; " + way_out);
+        coupling_field(c.numerics.coupling) + " = " +
+        scheme_fields(c.numerics.coupling, r.ib_given) +
+        ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
+        c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
+        format_value(a) + " --viscosity NU" + calibration::calibrate_options(c.numerics.coupling) +
+        " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
+        "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
   }
-  // Only reachable through an explicit U_inf: a given viscosity is range-checked
-  // above and the default U_inf is raised to stay inside the range.
-  if (c.numerics.viscosity < nu_min)
-    throw InputError(
-        "numerics.U_inf = " + format_value(c.derived.settling_velocity) + " with Re_inf = " +
-        format_value(c.physics.reynolds_inf) + " and a_over_dx = " + format_value(a) +
-        " gives viscosity = U_inf 2a / Re_inf = " + format_value(c.numerics.viscosity) +
-        ": must be >= " + format_value(nu_min) + " " + stable_why + "; " +
-        (c.physics.reynolds_inf > largest_re
-             ? beyond_reach()
-             : "raise numerics.U_inf to at least " +
-                   format_value(nu_min * c.physics.reynolds_inf / (2 * a)) + " or leave it out"));
+  try {
+    c.numerics.input_radius = table.input_radius(a, c.numerics.viscosity, c.numerics.coupling);
+    c.numerics.calibration_viscosity =
+        table.lookup(a, c.numerics.viscosity, c.numerics.coupling).viscosity;
+  } catch (const std::out_of_range& e) {
+    throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
+                     " Or give numerics.input_radius (the marker radius a_g) yourself.");
+  }
+  if (std::abs(std::log(c.numerics.calibration_viscosity / c.numerics.viscosity)) > std::log(2.0))
+    c.warnings.push_back("the hydrodynamic-radius calibration nearest to viscosity = " +
+                         format_value(c.numerics.viscosity) + " was made at " +
+                         format_value(c.numerics.calibration_viscosity) +
+                         "; `flocsim calibrate --viscosity` makes one for this viscosity");
+}
 
-  if (modules_of(c.scene).liquid && c.numerics.input_radius_given) {
-    // A hand-given a_g replaces the calibration, not the validation: the
-    // scheme must still be one the project offers (calibrated at some a).
-    const auto& table = calibration::CalibrationTable::shipped();
-    bool offered = false;
-    std::string names;
-    for (const auto& e : table.entries()) {
-      offered = offered || e.scheme.same_calibration(c.numerics.coupling);
-      const std::string n = scheme_fields(e.scheme);
-      if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
-    }
-    if (!offered) refuse_beyond_validated_phi();
-    if (!offered)
-      throw InputError(coupling_field(c.numerics.coupling) + " = " +
-                       scheme_fields(c.numerics.coupling, ib_given) +
-                       ": not an offered option (no calibration of it is shipped at any a); "
-                       "offered: " +
-                       names + " (docs/accuracy-cost.md)");
-  }
-  if (modules_of(c.scene).liquid && !c.numerics.input_radius_given) {
-    // a_g for this a from the shipped calibration, interpolated in log(nu)
-    // between the calibrated viscosities around this one
-    const auto& table = calibration::CalibrationTable::shipped();
-    if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
-      refuse_beyond_validated_phi();
-    if (table.has(a, coupling::kPaperScheme) && !table.has(a, c.numerics.coupling))
-      throw InputError(
-          coupling_field(c.numerics.coupling) + " = " +
-          scheme_fields(c.numerics.coupling, ib_given) +
-          ": not calibrated at numerics.a_over_dx = " + format_value(a) + " (" +
-          c.numerics.coupling.describe() + "); calibrate it with `flocsim calibrate --radius " +
-          format_value(a) + " --viscosity NU" +
-          calibration::calibrate_options(c.numerics.coupling) +
-          " --table engine/calibration/hydrodynamic_radius.json` and rebuild, or choose a "
-          "calibrated scheme (docs/immersed-boundary.md, \"Options\")");
-    try {
-      c.numerics.input_radius = table.input_radius(a, c.numerics.viscosity, c.numerics.coupling);
-      c.numerics.calibration_viscosity =
-          table.lookup(a, c.numerics.viscosity, c.numerics.coupling).viscosity;
-    } catch (const std::out_of_range& e) {
-      throw InputError("numerics.a_over_dx = " + format_value(a) + ": " + e.what() +
-                       " Or give numerics.input_radius (the marker radius a_g) yourself.");
-    }
-    if (std::abs(std::log(c.numerics.calibration_viscosity / c.numerics.viscosity)) > std::log(2.0))
-      c.warnings.push_back("the hydrodynamic-radius calibration nearest to viscosity = " +
-                           format_value(c.numerics.viscosity) + " was made at " +
-                           format_value(c.numerics.calibration_viscosity) +
-                           "; `flocsim calibrate --viscosity` makes one for this viscosity");
-  }
+// The coupling's period-2 oscillation (docs/numerics.md): with more than one
+// forcing sweep below a = 6 dx, moving spheres at nu = 0.01 (the a = 4 stand-in
+// of the standard box) developed it from t = 26 a/U_inf in all five runs
+// measured, with and without the well and with either close-pair model: three
+// blew up, two shook 11-42 % of the spheres every step to the end. nu = 0.0133
+// and 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01.
+void check_multi_sweep_floor(const Reading& r) {
+  const SuspensionCase& c = r.c;
+  if (!multi_sweep_oscillates(c)) return;
+  std::vector<std::string> remedies;
+  const double u_needed = settling_velocity_at_multi_sweep_floor(c);
+  if (r.has_nu)
+    remedies.push_back("raise numerics.viscosity to at least " +
+                       format_value(kSmallestMultiSweepViscosityBelowA6));
+  else if (u_needed <= kMaxSettlingVelocity)
+    remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
+  if (c.physics.phi <= coupling::largest_validated_phi(coupling::kOneSweepScheme))
+    remedies.push_back(
+        "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
+        "\"sweeps\": 1})");
+  remedies.push_back("raise numerics.a_over_dx to 6");
+  std::string ways;
+  for (std::size_t k = 0; k < remedies.size(); ++k)
+    ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];
+  throw InputError(
+      "numerics: viscosity = " + format_value(c.numerics.viscosity) + " with " +
+      std::to_string(c.numerics.coupling.sweeps) +
+      " immersed-boundary sweeps at a_over_dx = " + format_value(c.numerics.radius_cells) +
+      ": the coupling of moving spheres is measured to oscillate there below "
+      "viscosity " +
+      format_value(kSmallestMultiSweepViscosityBelowA6) + " (docs/numerics.md); " + ways);
+}
 
-  // The coupling's period-2 oscillation (docs/numerics.md): with more than one
-  // forcing sweep below a = 6 dx, moving spheres at nu = 0.01 (the a = 4 stand-in
-  // of the standard box) developed it from t = 26 a/U_inf in all five runs
-  // measured, with and without the well and with either close-pair model: three
-  // blew up, two shook 11-42 % of the spheres every step to the end. nu = 0.0133
-  // and 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01.
-  if (multi_sweep_oscillates(c)) {
-    std::vector<std::string> remedies;
-    const double u_needed = settling_velocity_at_multi_sweep_floor(c);
-    if (has_nu)
-      remedies.push_back("raise numerics.viscosity to at least " +
-                         format_value(kSmallestMultiSweepViscosityBelowA6));
-    else if (u_needed <= kMaxSettlingVelocity)
-      remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
-    if (c.physics.phi <= coupling::largest_validated_phi(coupling::kOneSweepScheme))
-      remedies.push_back(
-          "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
-          "\"sweeps\": 1})");
-    remedies.push_back("raise numerics.a_over_dx to 6");
-    std::string ways;
-    for (std::size_t k = 0; k < remedies.size(); ++k)
-      ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];
-    throw InputError("numerics: viscosity = " + format_value(c.numerics.viscosity) + " with " +
-                     std::to_string(c.numerics.coupling.sweeps) +
-                     " immersed-boundary sweeps at a_over_dx = " + format_value(a) +
-                     ": the coupling of moving spheres is measured to oscillate there below "
-                     "viscosity " +
-                     format_value(kSmallestMultiSweepViscosityBelowA6) + " (docs/numerics.md); " +
-                     ways);
+// lubrication_model calibrated: the lattice's share from the shipped close-pair table.
+void apply_lubrication_calibration(SuspensionCase& c) {
+  if (!modules_of(c.scene).lubrication || c.physics.lubrication_model != "calibrated") return;
+  const double a = c.numerics.radius_cells;
+  const auto& pairs = calibration::PairResistanceTable::shipped();
+  try {
+    c.numerics.lubrication_lattice_share =
+        pairs.lattice_share(a, c.numerics.viscosity, c.numerics.coupling);
+  } catch (const std::out_of_range& e) {
+    throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
+                     format_value(a) + ": " + e.what());
   }
+  const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.coupling);
+  if (gap > kNearViscosityFactor)
+    c.warnings.push_back(
+        "the close-pair calibration nearest to viscosity = " + format_value(c.numerics.viscosity) +
+        " at a_over_dx = " + format_value(a) + " lies a factor " + format_value(gap) + " away; `" +
+        calibration::close_pair_calibrate_command(a, c.numerics.viscosity, c.numerics.coupling) +
+        "` and a rebuild make one");
+  if (c.numerics.input_radius_given)
+    c.warnings.push_back(
+        "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +
+        format_value(a) + "; with numerics.input_radius given it holds only approximately");
+}
 
-  if (modules_of(c.scene).lubrication && c.physics.lubrication_model == "calibrated") {
-    const auto& pairs = calibration::PairResistanceTable::shipped();
-    try {
-      c.numerics.lubrication_lattice_share =
-          pairs.lattice_share(a, c.numerics.viscosity, c.numerics.coupling);
-    } catch (const std::out_of_range& e) {
-      throw InputError("lubrication_model = \"calibrated\" with numerics.a_over_dx = " +
-                       format_value(a) + ": " + e.what());
-    }
-    const double gap = pairs.viscosity_gap(a, c.numerics.viscosity, c.numerics.coupling);
-    if (gap > kNearViscosityFactor)
-      c.warnings.push_back(
-          "the close-pair calibration nearest to viscosity = " +
-          format_value(c.numerics.viscosity) + " at a_over_dx = " + format_value(a) +
-          " lies a factor " + format_value(gap) + " away; `" +
-          calibration::close_pair_calibrate_command(a, c.numerics.viscosity, c.numerics.coupling) +
-          "` and a rebuild make one");
-    if (c.numerics.input_radius_given)
-      c.warnings.push_back(
-          "the close-pair calibration was made with the shipped marker radius for a_over_dx = " +
-          format_value(a) + "; with numerics.input_radius given it holds only approximately");
-  }
-
+void read_protocol(InputReader& root, SuspensionCase& c, const Preset& p) {
   InputReader pr = root.object("protocol");
-  const Range duration{.at_least = 0, .at_most = 1e5};
-  c.protocol.stage1_min = pr.number("stage1_min", duration, p.stage1_min);
-  c.protocol.stage1_max = pr.number(
-      "stage1_max",
-      {.at_least = c.protocol.stage1_min, .at_most = 1e5, .why = "(at least protocol.stage1_min)"},
+  Protocol& t = c.protocol;
+  t.stage1_min = case_number(pr, "stage1_min", std::nullopt, p.stage1_min);
+  t.stage1_max = case_number(
+      pr, "stage1_max",
+      Range{.at_least = t.stage1_min, .at_most = 1e5, .why = "(at least protocol.stage1_min)"},
       p.stage1_max);
-  c.protocol.stage2_settle = pr.number("stage2_settle", duration, p.stage2_settle);
-  c.protocol.statistics = pr.number("statistics", {.above = 0, .at_most = 1e5}, p.statistics);
-  c.protocol.sample_every = pr.number("sample_every", {.above = 0, .at_most = 100}, 0.5);
-  c.protocol.stationarity_window =
-      pr.number("stationarity_window", {.above = 0, .at_most = 1e4}, 20.0);
-  c.protocol.snapshot_every = pr.number("snapshot_every", duration, 10.0);
-  c.protocol.checkpoint_every_s = pr.number("checkpoint_every_s", {.above = 0}, 600.0);
-  c.protocol.progress_every_s = pr.number("progress_every_s", {.above = 0, .at_most = 3600}, 2.0);
-  c.protocol.threads = static_cast<int>(pr.integer("threads", {.at_least = 0, .at_most = 1024}, 0));
+  t.stage2_settle = case_number(pr, "stage2_settle", std::nullopt, p.stage2_settle);
+  t.statistics = case_number(pr, "statistics", std::nullopt, p.statistics);
+  t.sample_every = case_number(pr, "sample_every");
+  t.stationarity_window = case_number(pr, "stationarity_window");
+  t.snapshot_every = case_number(pr, "snapshot_every");
+  t.checkpoint_every_s = case_number(pr, "checkpoint_every_s");
+  t.progress_every_s = case_number(pr, "progress_every_s");
+  t.threads = static_cast<int>(case_integer(pr, "threads"));
   pr.finish();
-  if (c.protocol.statistics < 20 * c.protocol.sample_every)
+  if (t.statistics < 20 * t.sample_every)
     throw InputError(
-        "protocol.statistics = " + format_value(c.protocol.statistics) +
-        ": must be >= 20 x protocol.sample_every = " + format_value(20 * c.protocol.sample_every) +
+        "protocol.statistics = " + exact_value(t.statistics) +
+        ": must be >= 20 x protocol.sample_every = " + format_value(20 * t.sample_every) +
         " (10 batch means of at least 2 samples each)");
-  root.finish();
+}
 
-  // ---- lattice-unit quantities (docs/model.md section 2) -----------------------------
+// The box in cells and the sphere count (from phi, or from the snapshot),
+// with the phi limit of the coupling scheme at the realised N.
+void derive_box_and_spheres(Reading& r) {
+  SuspensionCase& c = r.c;
+  const double a = c.numerics.radius_cells;
   const int L = static_cast<int>(std::lround(c.physics.length_over_a * a));
   const int W = static_cast<int>(std::lround(L / c.physics.length_over_width));
   c.derived.box = {L, W, W};
@@ -692,13 +758,14 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
   // well and event ranges, 2(a + delta) plus a skin, are shorter): that must
   // stay below half the box so that a pair has one periodic image only.
   if (W <= 6 * a)
-    throw InputError("L_over_W = " + format_value(c.physics.length_over_width) +
-                     " with L_over_a = " + format_value(c.physics.length_over_a) +
+    throw InputError("L_over_W = " + exact_value(c.physics.length_over_width) +
+                     " with L_over_a = " + exact_value(c.physics.length_over_a) +
                      ": makes the box width W = " + std::to_string(W) +
                      " cells; must exceed 6a = " + format_value(6 * a) +
                      " so that pairs within 3a have a single periodic image");
   const double volume = static_cast<double>(L) * W * W;
   const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
+  const bool single = c.scene == Scene::single_sphere;
   c.derived.sphere_count =
       single ? 1 : static_cast<int>(std::lround(c.physics.phi * volume / sphere_volume));
   if (!c.positions_from.empty()) {
@@ -708,18 +775,22 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
     c.physics.phi = c.derived.sphere_count * sphere_volume / volume;
   }
   if (c.derived.sphere_count < 1)
-    throw InputError("phi = " + format_value(c.physics.phi) +
+    throw InputError("phi = " + exact_value(c.physics.phi) +
                      ": gives N = 0 spheres in this box; raise phi or L_over_a");
   c.derived.phi_realised = c.derived.sphere_count * sphere_volume / volume;
   // The smallest phi that rounds to this N (a small box at phi = 0.2 holds
   // 0.2015: rounding, not a denser suspension), for a snapshot's N too.
   const double phi_asked = (c.derived.sphere_count - 0.5) * sphere_volume / volume;
-  if (modules_of(c.scene).liquid &&
-      phi_asked > coupling::largest_validated_phi(c.numerics.coupling))
-    throw beyond_validated_phi(c.numerics.coupling, ib_given,
+  if (has_liquid(c) && phi_asked > coupling::largest_validated_phi(c.numerics.coupling))
+    throw beyond_validated_phi(c.numerics.coupling, r.ib_given,
                                c.positions_from.empty() ? c.physics.phi : c.derived.phi_realised);
   if (single) c.physics.phi = c.derived.phi_realised;
+}
 
+// The lattice-unit forces (docs/model.md section 2).
+void derive_forces(SuspensionCase& c) {
+  const double a = c.numerics.radius_cells;
+  const double sphere_volume = 4.0 / 3.0 * M_PI * a * a * a;
   c.derived.drag_coefficient = schiller_naumann_drag_coefficient(c.physics.reynolds_inf);
   const double U = c.derived.settling_velocity;
   c.derived.gravity =
@@ -732,16 +803,52 @@ SuspensionCase parse_suspension_case(const nlohmann::json& document) {
       c.derived.phi_realised * (c.physics.density_ratio - 1.0) * c.derived.gravity;
   c.derived.sphere_net_gravity = (1.0 - c.derived.phi_realised) * (c.physics.density_ratio - 1.0) *
                                  sphere_volume * c.derived.gravity;
+}
 
+// The lattice must fit in 80 % of this machine's memory.
+void check_memory(const SuspensionCase& c) {
   const double bytes = static_cast<double>(c.derived.box.cells()) * 19.0 *
                        (c.numerics.single_precision ? 4.0 : 8.0) * 1.25;
   const double available = physical_memory_bytes();
-  if (modules_of(c.scene).liquid && available > 0 && bytes > 0.8 * available)
-    throw InputError("L_over_a = " + format_value(c.physics.length_over_a) +
-                     ", a_over_dx = " + format_value(a) + ": the " + std::to_string(L) + " x " +
-                     std::to_string(W) + " x " + std::to_string(W) + " lattice needs " +
+  if (has_liquid(c) && available > 0 && bytes > 0.8 * available)
+    throw InputError("L_over_a = " + exact_value(c.physics.length_over_a) +
+                     ", a_over_dx = " + exact_value(c.numerics.radius_cells) + ": the " +
+                     std::to_string(c.derived.box.nx) + " x " + std::to_string(c.derived.box.ny) +
+                     " x " + std::to_string(c.derived.box.nz) + " lattice needs " +
                      format_value(bytes / 1e9) + " GB; must fit in 80 % of this machine's " +
                      format_value(available / 1e9) + " GB");
+}
+
+}  // namespace
+
+SuspensionCase parse_suspension_case(const nlohmann::json& document) {
+  Reading r;
+  SuspensionCase& c = r.c;
+  InputReader root(document, "");
+  c.scene = scene_from_name(root.choice("scene", scene_names(/*with_spheres=*/true)));
+  // every field against its declaration: unknown, unused in this scene, type, range
+  c.warnings = input::check_fields(case_field_table(), document, scene_context(c.scene));
+  read_identity(root, c);
+  r.p = preset(c.fidelity);
+  read_positions_source(root, c);
+  read_physics(root, c, r.p);
+  InputReader num = root.object("numerics");
+  read_velocity_scale(num, r);
+  read_scheme(num, r);
+  if (document.contains("numerics") && document["numerics"].contains("immersed_boundary"))
+    r.ib_given = document["numerics"]["immersed_boundary"];
+  read_input_radius(num, c);
+  num.finish();
+  check_mach_cap(c);
+  check_stability_floor(c);
+  apply_radius_calibration(r);
+  check_multi_sweep_floor(r);
+  apply_lubrication_calibration(c);
+  read_protocol(root, c, r.p);
+  root.finish();
+  derive_box_and_spheres(r);
+  derive_forces(c);
+  check_memory(c);
   return c;
 }
 

@@ -39,6 +39,15 @@ inline constexpr double kMaxSettlingVelocityWithoutLiquid = 0.05;
 // period-2 oscillation (docs/numerics.md): 0.0133 = U_inf 0.02 at a = 4 and
 // Re_inf 12 (clean for 80 a/U_inf, where nu = 0.01 oscillated from t = 26).
 inline constexpr double kSmallestMultiSweepViscosityBelowA6 = 0.04 / 3;
+// Largest lattice viscosity accepted in a scene with liquid, whether given
+// (numerics.viscosity) or implied by Re_inf and U_inf (nu = 2 a U_inf /
+// Re_inf): one rule, the viscosity ceiling (docs/numerics.md, "Viscosity
+// ceiling"). Measured at a = 4 against runs at nu = 1/6 (tau = 1, the largest
+// calibrated viscosity) with the same Re_inf: a single sphere settled 0.7 %
+// fast at nu 0.2, 1.8 % at 0.25, 2.8 % at 0.3, 3.1 % at 0.5 and blew up at
+// 0.75 and 1; suspensions (phi 0.1) ran at 0.2 (three seeds) and blew up
+// within 10 a/U_inf at 0.25, 0.3, 0.5, 0.75 and 1.
+inline constexpr double kLargestViscosity = 0.2;
 
 // Smallest viscosity at which the coupled solver (lattice, immersed boundary,
 // spheres) is measured stable at a resolution of a_over_dx cells per radius:

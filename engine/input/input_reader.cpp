@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "engine/input/field_table.hpp"
+
 namespace flocsim::input {
 
 namespace {
@@ -71,7 +73,7 @@ double InputReader::number(const std::string& key, const Range& range,
     throw InputError(field(key) + " = " + shown(*v) + ": must be a number " + range.describe());
   const double x = v->get<double>();
   if (!range.contains(x))
-    throw InputError(field(key) + " = " + format_number(x) + ": must be " + range.describe());
+    throw InputError(field(key) + " = " + exact_number(x) + ": must be " + range.describe());
   return x;
 }
 
@@ -150,7 +152,7 @@ std::vector<double> InputReader::numbers(const std::string& key, std::size_t len
       throw InputError(name + " = " + shown(e) + ": must be a number " + range.describe());
     const double x = e.get<double>();
     if (!range.contains(x))
-      throw InputError(name + " = " + format_number(x) + ": must be " + range.describe());
+      throw InputError(name + " = " + exact_number(x) + ": must be " + range.describe());
     out.push_back(x);
   }
   return out;
@@ -174,7 +176,10 @@ void InputReader::finish() const {
     sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
     std::string list;
     for (std::size_t i = 0; i < sorted.size(); ++i) list += (i ? ", " : "") + sorted[i];
-    throw InputError(field(it.key()) + ": unknown key (known keys here: " + list + ")");
+    const std::string near = nearest_name(it.key(), sorted);
+    throw InputError(field(it.key()) + ": unknown key" +
+                     (near.empty() ? std::string() : "; did you mean " + field(near) + "?") +
+                     " (known keys here: " + list + ")");
   }
 }
 
