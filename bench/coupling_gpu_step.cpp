@@ -192,7 +192,8 @@ int main(int argc, char** argv) {
                                             : time_option<double>(e, s, scheme, steps, reps);
       std::printf("%-34s %-6s %12.0f %12.0f %7.0f%% %8.3f\n", scheme.describe().c_str(), p.c_str(),
                   r["fluid_MLUPS"].get<double>(), r["full_step_MLUPS"].get<double>(),
-                  100 * r["full_over_fluid"].get<double>(), r["immersed_boundary_ms"].get<double>());
+                  100 * r["full_over_fluid"].get<double>(),
+                  r["immersed_boundary_ms"].get<double>());
       all.push_back(r);
     }
   std::printf("target: full step >= 50 %% of the fluid alone (issue 39)\n");

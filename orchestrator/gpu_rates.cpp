@@ -87,8 +87,8 @@ std::optional<double> GpuRates::step_s(const cases::ParsedCase& c, const run::Ca
     for (const GpuFluidRate& f : fluid)
       if (f.single_precision == size.single_precision && !f.force_field)
         return static_cast<double>(size.cells) / (f.mlups * 1e6);
-    why = std::string("no fluid benchmark in ") + precision + " with a uniform body force in " +
-          file;
+    why =
+        std::string("no fluid benchmark in ") + precision + " with a uniform body force in " + file;
     return std::nullopt;
   }
   if (size.cells == 0) {

@@ -371,9 +371,8 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
             "raise the limit or lower runs_per_task");
     }
   }
-  if (o.gpu && std::any_of(plan.runs.begin(), plan.runs.end(), [](const PlannedRun& r) {
-        return r.gpu_step_s && r.size.spheres > 0;
-      }))
+  if (o.gpu && std::any_of(plan.runs.begin(), plan.runs.end(),
+                           [](const PlannedRun& r) { return r.gpu_step_s && r.size.spheres > 0; }))
     plan.notes.push_back(
         "sphere scenes do not run on the GPU yet (docs/gpu.md): their GPU figures project the "
         "benchmark's coupled step (the immersed boundary and the lattice on the GPU, the sphere "

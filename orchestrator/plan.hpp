@@ -24,11 +24,11 @@ class ResultsDb;
 namespace flocsim::orchestrator {
 
 struct PlanOptions {
-  int jobs = 1;                      // local backend: runs at once
-  std::string backend = "local";     // local | slurm
-  int measure_steps = 3;             // steps timed per configuration at least; 0: none
-  double measure_seconds = 1.0;      // ... and at least this long
-  db::ResultsDb* db = nullptr;       // completed runs give the rate; complete runs are skipped
+  int jobs = 1;                   // local backend: runs at once
+  std::string backend = "local";  // local | slurm
+  int measure_steps = 3;          // steps timed per configuration at least; 0: none
+  double measure_seconds = 1.0;   // ... and at least this long
+  db::ResultsDb* db = nullptr;    // completed runs give the rate; complete runs are skipped
   // A GPU's benchmark figures (--gpu-rate): every configuration the GPU can
   // run is estimated on it, one GPU per worker, instead of measured here.
   const GpuRates* gpu = nullptr;
@@ -81,8 +81,8 @@ struct SweepPlan {
   int to_run = 0, refused = 0, complete = 0;
   double lattice_updates_min = 0, lattice_updates_max = 0;  // of the runs to run
   std::optional<double> wall_min_s, wall_max_s;             // the whole sweep
-  std::optional<double> core_hours_min, core_hours_max;  // of the runs on CPU cores
-  double gpu_hours_min = 0, gpu_hours_max = 0;          // of the runs estimated on a GPU
+  std::optional<double> core_hours_min, core_hours_max;     // of the runs on CPU cores
+  double gpu_hours_min = 0, gpu_hours_max = 0;              // of the runs estimated on a GPU
   double memory_per_run_max = 0;   // bytes, the largest configuration measured
   std::vector<std::string> notes;  // warnings: memory, Slurm time limits
 };

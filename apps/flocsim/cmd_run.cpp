@@ -56,8 +56,8 @@ int run_command(const RunArguments& a) {
     // checked with the case, against this machine's); the lattice takes its
     // memory before any output too, should another process take it meanwhile
     // (a sphere scene adds the 3-component force field the immersed boundary writes)
-    const double cells = static_cast<double>(parsed.fluid_scene ? parsed.fluid.size.cells()
-                                                                : parsed.spheres.derived.box.cells());
+    const double cells = static_cast<double>(
+        parsed.fluid_scene ? parsed.fluid.size.cells() : parsed.spheres.derived.box.cells());
     const bool single = parsed.fluid_scene
                             ? parsed.fluid.precision == cases::Precision::single_precision
                             : parsed.spheres.numerics.single_precision;

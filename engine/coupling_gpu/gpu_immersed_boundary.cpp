@@ -28,8 +28,7 @@ MarkerSetup marker_setup(const immersed_boundary::ImmersedBoundarySettings& sett
 }
 
 template <class Real>
-GpuImmersedBoundary<Real>::GpuImmersedBoundary(
-    immersed_boundary::ImmersedBoundarySettings settings)
+GpuImmersedBoundary<Real>::GpuImmersedBoundary(immersed_boundary::ImmersedBoundarySettings settings)
     : settings_(settings) {
   immersed_boundary::check_settings(settings);
   if (settings.measure_slip)

@@ -161,8 +161,7 @@ __global__ void __launch_bounds__(kThreads, sizeof(Real) == 4 ? 2 : 1)
     box.force = reinterpret_cast<Real*>(box_shared);
   else
     box.force = p.box_force + 4 * static_cast<long>(cells) * s;
-  for (int d = 0; d < 3; ++d)
-    box.lo[d] = static_cast<int>(::floor(centre[d] - p.input_radius)) - 2;
+  for (int d = 0; d < 3; ++d) box.lo[d] = static_cast<int>(::floor(centre[d] - p.input_radius)) - 2;
 
   // load: the velocity the next collision would see without per-cell force
   for (int c = threadIdx.x; c < cells; c += blockDim.x) {
@@ -190,7 +189,8 @@ __global__ void __launch_bounds__(kThreads, sizeof(Real) == 4 ? 2 : 1)
     __syncthreads();
   } else {
     for (int m = threadIdx.x; m < p.markers; m += blockDim.x)
-      for (int q = 0; q < 4; ++q) p.marker_force[4 * (static_cast<long>(s) * p.markers + m) + q] = 0;
+      for (int q = 0; q < 4; ++q)
+        p.marker_force[4 * (static_cast<long>(s) * p.markers + m) + q] = 0;
     for (int sweep = 0; sweep < p.sweeps; ++sweep) {
       interpolate_and_force<Real, W>(p, box, centre, up, omega, s, sweep > 0);
       __syncthreads();
@@ -280,7 +280,7 @@ struct MarkerKernels<Real>::Device {
   std::size_t poses_held = 0, loads_held = 0;
   double *pinned_poses = nullptr, *pinned_loads = nullptr;  // host, page-locked
   std::size_t pinned_held = 0;
-  std::size_t spheres = 0;  // of the last apply(): the carried markers' count
+  std::size_t spheres = 0;           // of the last apply(): the carried markers' count
   std::size_t shared_per_block = 0;  // dynamic shared memory the sphere kernel may take
 
   ~Device() {
@@ -356,8 +356,7 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
   const std::size_t box_bytes = sizeof(Real) * 4 * B * B * B;
   const bool in_shared = box_bytes <= dev.shared_per_block;
   if (!in_shared)
-    device_resize(dev.box_force, dev.box_force_held, 4 * B * B * B * n,
-                  "the sphere boxes' force");
+    device_resize(dev.box_force, dev.box_force_held, 4 * B * B * B * n, "the sphere boxes' force");
   device_resize(dev.increment, dev.inc_held, 4 * M * n, "the marker increments");
   if (setup_.control && dev.spheres != n) {  // a new sphere set: no carried force yet
     dev.force_held = dev.slip_held = 0;
@@ -486,9 +485,9 @@ void MarkerKernels<Real>::restore(const std::vector<Real>& force, const std::vec
   cuda_check(cudaMemcpy(dev.marker_force, force.data(), sizeof(Real) * force.size(),
                         cudaMemcpyHostToDevice),
              "upload of the marker forces");
-  cuda_check(cudaMemcpy(dev.marker_slip, slip.data(), sizeof(Real) * slip.size(),
-                        cudaMemcpyHostToDevice),
-             "upload of the marker slips");
+  cuda_check(
+      cudaMemcpy(dev.marker_slip, slip.data(), sizeof(Real) * slip.size(), cudaMemcpyHostToDevice),
+      "upload of the marker slips");
   dev.spheres = n;
 }
 

@@ -119,8 +119,8 @@ FLOCSIM_KERNEL_BODY void interpolate_at_marker(const SphereBox<Real>& box,
 // a sphere spread at once.
 template <class Real, int W, class Add>
 FLOCSIM_KERNEL_BODY void spread_from_marker(const SphereBox<Real>& box,
-                                            const MarkerStencil<Real, W>& st,
-                                            const Real (&F_dV)[3], Add&& add) {
+                                            const MarkerStencil<Real, W>& st, const Real (&F_dV)[3],
+                                            Add&& add) {
   for (int c = 0; c < W; ++c)
     for (int b = 0; b < W; ++b) {
       const Real wyz = st.wyz[b + W * c];

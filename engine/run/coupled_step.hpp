@@ -77,8 +77,8 @@ struct Liquid {
       // the case parser lets only the immersed boundary onto a GPU
       device->set_body_force(fluid.body_force());
       coupling = std::make_unique<gpu::GpuSphereCoupling<Real>>(
-          immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius,
-                                                      c.numerics.coupling, false},
+          immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius, c.numerics.coupling,
+                                                      false},
           *device);
     } else {
       coupling = coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius);

@@ -176,8 +176,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   // coupled_step.hpp); its memory is taken before the output folder is
   // touched, so a GPU that cannot hold the lattice refuses the run up front.
   std::unique_ptr<gpu::GpuFluidLattice<Real>> device = lattice_on_gpu<Real>(
-      c.device == cases::Device::cuda, c.derived.box,
-      {c.numerics.viscosity, c.numerics.trt_magic});
+      c.device == cases::Device::cuda, c.derived.box, {c.numerics.viscosity, c.numerics.trt_magic});
   const nlohmann::json device_record = device ? gpu_device_record(device->gpu()) : nlohmann::json();
   RunShell shell(o, c.to_json(), c.warnings, c.protocol.threads);
   if (shell.start() == StartMode::already_completed) return shell.already_completed();
@@ -218,8 +217,8 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   }
   if (liquid && liquid->device) {
     liquid->to_device();
-    log.info("lattice and immersed boundary on GPU " +
-             std::to_string(liquid->device->gpu().index) + ", " + liquid->device->gpu().name);
+    log.info("lattice and immersed boundary on GPU " + std::to_string(liquid->device->gpu().index) +
+             ", " + liquid->device->gpu().name);
   }
   log.info(
       std::string("flocsim ") + kFlocsimVersion + " " + std::string(cases::scene_name(c.scene)) +

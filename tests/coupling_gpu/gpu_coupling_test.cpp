@@ -17,11 +17,11 @@
 
 #include "engine/case/case_file.hpp"
 #include "engine/coupling_gpu/gpu_immersed_boundary.hpp"
-#include "engine/run/coupled_step.hpp"
-#include "engine/run/sphere_run.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/run/coupled_step.hpp"
+#include "engine/run/sphere_run.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
 #include "tests/immersed_boundary/coupling_scenes.hpp"
 #include "tests/lattice/lattice_probes.hpp"
@@ -29,17 +29,16 @@
 namespace flocsim::gpu {
 namespace {
 
-using testing::stir;
-using testing::control;
-using testing::direct;
-using testing::three_spheres;
 using immersed_boundary::ImmersedBoundary;
 using immersed_boundary::ImmersedBoundarySettings;
 using spheres::Vec3;
+using testing::control;
+using testing::direct;
+using testing::stir;
+using testing::three_spheres;
 
 template <class Real>
 constexpr double kRoundOff = sizeof(Real) == 8 ? 1e-12 : 1e-4;
-
 
 double largest(const std::vector<Vec3>& v) {
   double m = 0;
@@ -47,8 +46,8 @@ double largest(const std::vector<Vec3>& v) {
   return m;
 }
 
-void expect_near_lists(const std::vector<Vec3>& gpu, const std::vector<Vec3>& cpu,
-                       double relative, const char* what) {
+void expect_near_lists(const std::vector<Vec3>& gpu, const std::vector<Vec3>& cpu, double relative,
+                       const char* what) {
   ASSERT_EQ(gpu.size(), cpu.size()) << what;
   const double scale = largest(cpu);
   ASSERT_GT(scale, 0) << what << " is zero: the comparison would prove nothing";
@@ -107,7 +106,6 @@ void expect_same_steps(const coupling::Scheme& scheme, int steps) {
   }
 }
 
-
 TEST(GpuCoupling, DirectForcingStepsMatchTheCpuCoupling) {
   expect_same_steps<double>(direct(1, coupling::Kernel::roma3), 3);
   expect_same_steps<double>(direct(2, coupling::Kernel::linear2), 3);
@@ -134,7 +132,8 @@ TEST(GpuCoupling, SettlingSphereFollowsTheCpuTrajectory) {
   dynamics.external = spheres::settling_forces(1, a, 4.0, static_cast<double>(e.cells()), 2e-6);
   cpu_fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
   gpu_fluid.upload(cpu_fluid);
-  const ImmersedBoundarySettings settings{.input_radius = ag, .scheme = direct(2, coupling::Kernel::roma3)};
+  const ImmersedBoundarySettings settings{.input_radius = ag,
+                                          .scheme = direct(2, coupling::Kernel::roma3)};
   ImmersedBoundary<double> cpu(settings);
   GpuImmersedBoundary<double> gpu(settings);
   spheres::SphereSet s_cpu;
@@ -196,8 +195,12 @@ TEST(GpuCoupling, ControlForcingStateMovesFromTheGpuToTheCpu) {
 // difference could flip one; over 300 steps of a dilute start none does, and
 // the bound would show it.)
 TEST(GpuCoupling, ASuspensionsCoupledStepFollowsTheCpuTrajectories) {
-  const nlohmann::json doc = {{"scene", "suspension"}, {"fidelity", "draft"}, {"phi", 0.2},
-                              {"Re_inf", 24},          {"du_over_Uinf", 0.03}, {"precision", "double"},
+  const nlohmann::json doc = {{"scene", "suspension"},
+                              {"fidelity", "draft"},
+                              {"phi", 0.2},
+                              {"Re_inf", 24},
+                              {"du_over_Uinf", 0.03},
+                              {"precision", "double"},
                               {"numerics", {{"U_inf", 0.03}}}};
   cases::SuspensionCase c = cases::parse_case(doc).spheres;
   run::TimedStages cpu_stages, gpu_stages;

@@ -16,6 +16,8 @@
 // so they agree to a few hundred ulps of the largest magnitude compared:
 // 1e-12 of it in double, 1e-4 in float (a float ulp is 6e-8; sums of ~10^3
 // terms and differences of near-equal velocities U - u cost up to ~10^3).
+#include "engine/immersed_boundary/marker_body.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,7 +27,6 @@
 #include "engine/coupling_gpu/gpu_immersed_boundary.hpp"
 #include "engine/coupling_gpu/marker_kernels.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
-#include "engine/immersed_boundary/marker_body.hpp"
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "tests/immersed_boundary/coupling_scenes.hpp"
@@ -34,11 +35,11 @@
 namespace flocsim::immersed_boundary {
 namespace {
 
-using testing::stir;
+using spheres::Vec3;
 using testing::control;
 using testing::direct;
+using testing::stir;
 using testing::three_spheres;
-using spheres::Vec3;
 
 struct PlainAdd {
   template <class Real>
@@ -52,8 +53,8 @@ struct PlainAdd {
 template <class Real>
 struct SerialState {
   std::vector<Real> marker_force, marker_slip;
-  std::vector<double> loads;      // 12 per sphere, as MarkerKernels::apply
-  std::vector<Real> field[3];     // the lattice's force field, x fastest
+  std::vector<double> loads;   // 12 per sphere, as MarkerKernels::apply
+  std::vector<Real> field[3];  // the lattice's force field, x fastest
 };
 
 // One apply() of the GPU coupling, serially: marker_kernels.cu's
@@ -181,7 +182,6 @@ void serial_apply(const gpu::MarkerSetup& setup, const lattice::AaSlots<Real>& s
   }
 }
 
-
 double largest(const std::vector<double>& v) {
   double m = 0;
   for (double x : v) m = std::max(m, std::abs(x));
@@ -245,8 +245,7 @@ void expect_serial_launcher_matches_cpu(coupling::Scheme scheme, int steps) {
     // before its force is applied, at the lattice's current parity
     std::vector<Real> slots = testing::slots_of(fluid);
     const lattice::AaSlots<Real> s{slots.data(), e.cells(), e.nx, e.ny, e.nz};
-    serial_apply<Real, W>(setup, s, fluid.time_step() % 2 == 0, fluid.body_force(), spheres,
-                          state);
+    serial_apply<Real, W>(setup, s, fluid.time_step() % 2 == 0, fluid.body_force(), spheres, state);
     cpu.apply(fluid, spheres);
     SCOPED_TRACE("step " + std::to_string(step) + " (time step " +
                  std::to_string(fluid.time_step()) + ")");
@@ -268,7 +267,6 @@ void expect_serial_launcher_matches_cpu(coupling::Scheme scheme, int steps) {
     }
   }
 }
-
 
 TEST(MarkerBody, OneSweepRomaMatchesTheCpuCouplingInDouble) {
   expect_serial_launcher_matches_cpu<double, 3>(direct(1, coupling::Kernel::roma3), 2);
@@ -311,13 +309,15 @@ TEST(MarkerBody, StencilWeightsAreTheKernelAtTheCellDistances) {
     EXPECT_NEAR(hat.wx[a], linear_kernel(cell(0, hat.first[0], a) - X[0]), 1e-15);
   for (int c = 0; c < 3; ++c)
     for (int b = 0; b < 3; ++b)
-      EXPECT_NEAR(roma.wyz[b + 3 * c], roma_kernel(cell(1, roma.first[1], b) - X[1]) *
-                                           roma_kernel(cell(2, roma.first[2], c) - X[2]),
+      EXPECT_NEAR(roma.wyz[b + 3 * c],
+                  roma_kernel(cell(1, roma.first[1], b) - X[1]) *
+                      roma_kernel(cell(2, roma.first[2], c) - X[2]),
                   1e-15);
   for (int c = 0; c < 2; ++c)
     for (int b = 0; b < 2; ++b)
-      EXPECT_NEAR(hat.wyz[b + 2 * c], linear_kernel(cell(1, hat.first[1], b) - X[1]) *
-                                          linear_kernel(cell(2, hat.first[2], c) - X[2]),
+      EXPECT_NEAR(hat.wyz[b + 2 * c],
+                  linear_kernel(cell(1, hat.first[1], b) - X[1]) *
+                      linear_kernel(cell(2, hat.first[2], c) - X[2]),
                   1e-15);
 }
 

@@ -157,15 +157,14 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
   const auto first = flocsim::cases::parse_case(orc::expand(spec).front().case_json);
   const flocsim::coupling::Scheme& scheme = first.spheres.numerics.coupling;
   const bool single = first.spheres.numerics.single_precision;
-  nlohmann::json bench = {
-      {"gpu", "NVIDIA H100 (test figures)"},
-      {"results",
-       {{{"option", scheme.describe()},
-         {"precision", single ? "float" : "double"},
-         {"fluid_MLUPS", 8000.0},
-         {"immersed_boundary_ms", 1.5},
-         {"spheres", 1320},
-         {"markers_per_sphere", 900}}}}};
+  nlohmann::json bench = {{"gpu", "NVIDIA H100 (test figures)"},
+                          {"results",
+                           {{{"option", scheme.describe()},
+                             {"precision", single ? "float" : "double"},
+                             {"fluid_MLUPS", 8000.0},
+                             {"immersed_boundary_ms", 1.5},
+                             {"spheres", 1320},
+                             {"markers_per_sphere", 900}}}}};
   const std::string file = dir + "/bench-coupling-gpu.json";
   std::ofstream(file) << bench.dump(2);
   const orc::GpuRates rates = orc::read_gpu_rates({file});
@@ -205,8 +204,8 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
   EXPECT_FALSE(without.wall_min_s);
   std::ostringstream why;
   orc::write_plan(without, why, false);
-  EXPECT_THAT(why.str(), HasSubstr("not on the GPU: no coupled-step benchmark of " +
-                                   scheme.describe()));
+  EXPECT_THAT(why.str(),
+              HasSubstr("not on the GPU: no coupled-step benchmark of " + scheme.describe()));
 }
 
 TEST(SweepPlan, RefusesAGpuRateFileThatIsNotABenchmarksOutput) {
