@@ -5,6 +5,8 @@
 #include <sstream>
 #include <string>
 
+#include "engine/input/field_table.hpp"
+
 namespace flocsim::cases {
 
 // A number as a user would type it (6 significant digits), for messages.
@@ -17,18 +19,9 @@ inline std::string format_value(double v) {
 
 // A number exactly as given (the shortest text that reads back as the same
 // double): for refusals at a boundary, where 6 digits would print a refused
-// value as an accepted one.
+// value as an accepted one. The field table's own (input/field_table.hpp).
 inline std::string exact_value(double v) {
-  for (int digits = 6; digits < 17; ++digits) {
-    std::ostringstream s;
-    s.precision(digits);
-    s << v;
-    if (std::stod(s.str()) == v) return s.str();
-  }
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
+  return input::exact_number(v);
 }
 
 // Physical memory of this machine in bytes (0 when the system does not say).

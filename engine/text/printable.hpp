@@ -59,6 +59,13 @@ inline bool is_terminal_control(std::uint32_t cp) {
          cp == 0x2028 || cp == 0x2029;                             // line, paragraph separator
 }
 
+// \uXXXX for a code point of the Basic Multilingual Plane (every control
+// is_terminal_control names is one).
+inline void append_u_escape(std::string& out, std::uint32_t cp) {
+  static constexpr char hex[] = "0123456789abcdef";
+  out += {'\\', 'u', hex[(cp >> 12) & 15], hex[(cp >> 8) & 15], hex[(cp >> 4) & 15], hex[cp & 15]};
+}
+
 // `text` as a terminal should show it (see above). Only printable ASCII is
 // added, so printable(printable(s)) == printable(s).
 inline std::string printable(std::string_view text) {
@@ -75,12 +82,7 @@ inline std::string printable(std::string_view text) {
       out += {'\\', 'x', hex[c.code_point >> 4], hex[c.code_point & 15]};
       i += 1;
     } else if (is_terminal_control(c.code_point)) {
-      out += {'\\',
-              'u',
-              hex[(c.code_point >> 12) & 15],
-              hex[(c.code_point >> 8) & 15],
-              hex[(c.code_point >> 4) & 15],
-              hex[c.code_point & 15]};
+      append_u_escape(out, c.code_point);
       i += c.length;
     } else {
       out.append(text.substr(i, c.length));
@@ -105,19 +107,13 @@ inline bool is_printable(std::string_view text) {
 // escapes: the same document, safe on a terminal. Such characters occur in
 // JSON text only inside strings, where \uXXXX stands for them exactly.
 inline std::string printable_json(std::string_view json_text) {
-  static constexpr char hex[] = "0123456789abcdef";
   std::string out;
   out.reserve(json_text.size());
   for (std::size_t i = 0; i < json_text.size();) {
     const Utf8Char c = decode_utf8(json_text, i);
     const std::size_t n = c.length == 0 ? 1 : c.length;
     if (c.length != 0 && c.code_point >= 0x20 && is_terminal_control(c.code_point))
-      out += {'\\',
-              'u',
-              hex[(c.code_point >> 12) & 15],
-              hex[(c.code_point >> 8) & 15],
-              hex[(c.code_point >> 4) & 15],
-              hex[c.code_point & 15]};
+      append_u_escape(out, c.code_point);
     else
       out.append(json_text.substr(i, n));
     i += n;
