@@ -496,7 +496,8 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
              "a symbol per Re_inf, error bars from the batch-means errors of both runs (Fig. 12)");
       p.commands()
           << "set multiplot layout 1," << by_phi.size()
-          << "\nset grid\nset xlabel '<n_a>/<n_a>_0'\nset ylabel 'F/F_0'\nset logscale x\n";
+          << "\nset grid\nset xlabel '<n_a>/<n_a>_0'\nset ylabel 'F/F_0'\nset logscale x\n"
+          << "set key top right font ',9'\n";  // F/F0 falls with size: that corner is free
       for (const auto& [phi, per_re] : by_phi) {
         std::string plots;
         int style = 5;
@@ -504,7 +505,32 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
           plots += (plots.empty() ? "" : ", ") + p.data(label(phi, re), rows) +
                    " with xyerrorbars pt " + std::to_string(style++) +
                    " ps 1.3 title 'Re_{inf} = " + num(re) + "'";
-        p.commands() << "set title 'phi = " << num(phi) << "'\nplot " << plots << "\n";
+        // The paper's comparison points at this phi: it states only their common
+        // normalised size (no F/F0), so a vertical line there, and flocsim's runs
+        // of the same (Re_inf, du) ringed, to show where they fall against it.
+        const std::vector<StatedComparisonPoint> stated = stated_comparison_points(phi);
+        std::string ringed, pairs;
+        for (const StatedComparisonPoint& q : stated) {
+          pairs += (pairs.empty() ? "(" : ", (") + num(q.re_inf) + ", " + num(q.du) + ")";
+          for (const AggregationRow& a : agg)
+            if (a.F_over_F0 && a.n_over_n0 && a.run->phi == phi && a.run->re_inf == q.re_inf &&
+                std::abs(a.run->du - q.du) <= 1e-9 * q.du)
+              ringed += num(a.n_over_n0->mean) + " " + num(a.F_over_F0->mean) + "\n";
+        }
+        std::string title = "phi = " + num(phi);
+        if (!stated.empty()) {
+          p.commands() << "set arrow 1 from " << num(stated.front().value) << ", graph 0 to "
+                       << num(stated.front().value)
+                       << ", graph 1 nohead dt 2 lw 1.5 lc rgb 'gray30'\n";
+          plots += ", NaN with lines dt 2 lw 1.5 lc rgb 'gray30' title 'paper: about " +
+                   num(stated.front().value) + "'";
+          if (!ringed.empty())
+            plots += ", " + p.data("phi" + num(phi) + "_stated", ringed) +
+                     " with points pt 6 ps 3 lc rgb 'black' title 'flocsim at those points'";
+          title += "\\n{/*0.75 the paper's points (Re_{inf}, du/U_{inf}): " + pairs + "}";
+        }
+        p.commands() << "set title \"" << title << "\"\nplot " << plots << "\n"
+                     << "unset arrow 1\n";
       }
       for (const AggregationRow& a : agg)
         if (a.F_over_F0 && a.n_over_n0) {

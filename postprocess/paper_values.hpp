@@ -61,22 +61,38 @@ struct PaperBaselineRange {
   double low, high;
 };
 
-namespace detail {
-struct StatedRatio {
+// The comparison points of the paper's discussion of Fig. 12, as printed:
+// (phi, Re_inf, du/U_inf) and the normalised size it gives them ("about").
+// `inside_simulated_range` is false for (0.12, 6, 0.05): drawn beside
+// flocsim's run of the same triple in Fig. 12, never used for a bound (above).
+struct StatedComparisonPoint {
   double phi, re_inf, du, value;
+  bool inside_simulated_range = true;
 };
-inline constexpr StatedRatio kStatedRatios[] = {{0.12, 72, 0.03, 2.3}, {0.12, 24, 0.025, 2.3},
-                                                {0.12, 12, 0.02, 2.3}, {0.2, 48, 0.03, 7.6},
-                                                {0.2, 12, 0.025, 7.6}, {0.2, 6, 0.02, 7.6}};
+inline constexpr StatedComparisonPoint kStatedComparisonPoints[] = {
+    {0.12, 72, 0.03, 2.3},       {0.12, 24, 0.025, 2.3}, {0.12, 12, 0.02, 2.3},
+    {0.12, 6, 0.05, 2.3, false}, {0.2, 48, 0.03, 7.6},   {0.2, 12, 0.025, 7.6},
+    {0.2, 6, 0.02, 7.6}};
+
+namespace detail {
 inline bool same(double x, double y) {
   return std::abs(x - y) <= 1e-9 * std::abs(y);
 }
+using StatedRatio = StatedComparisonPoint;
 inline const StatedRatio* stated_ratio(double phi, double re_inf) {
-  for (const StatedRatio& s : kStatedRatios)
-    if (same(phi, s.phi) && same(re_inf, s.re_inf)) return &s;
+  for (const StatedRatio& s : kStatedComparisonPoints)
+    if (s.inside_simulated_range && same(phi, s.phi) && same(re_inf, s.re_inf)) return &s;
   return nullptr;
 }
 }  // namespace detail
+
+// The stated comparison points at this phi, as printed (empty for any other).
+inline std::vector<StatedComparisonPoint> stated_comparison_points(double phi) {
+  std::vector<StatedComparisonPoint> out;
+  for (const StatedComparisonPoint& s : kStatedComparisonPoints)
+    if (detail::same(phi, s.phi)) out.push_back(s);
+  return out;
+}
 
 inline std::optional<PaperBaselineRange> paper_baseline_range(double phi, double re_inf) {
   const detail::StatedRatio* r = detail::stated_ratio(phi, re_inf);

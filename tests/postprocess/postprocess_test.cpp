@@ -467,6 +467,41 @@ TEST_F(Post, FiguresAreRealPngAndPdfFilesAndTheReportEmbedsThem) {
   EXPECT_THAT(html.str(), HasSubstr(">completed</td>"));  // the provenance table's state
 }
 
+// Fig. 12 with the paper's comparison points: the paper states only their common
+// normalised size (about 7.6 at phi 0.2), so the panel draws a line there and
+// rings flocsim's run of a stated (Re_inf, du), and nothing at a phi without any.
+TEST_F(Post, TheDragRatioPanelsDrawThePapersStatedSizeAndRingTheStatedRuns) {
+  auto at_phi = [](json c, double phi) {
+    c["phi"] = phi;
+    return orchestrator::canonical(c);
+  };
+  // phi 0.2, Re_inf 12: baseline F0 4.0, <n_a>0 2.0; stated du 0.025: F 3.0, <n_a> 16
+  // (by hand: 8 and 0.75); du 0.02 is not a stated point. phi 0.32: none stated.
+  const std::string db_path =
+      write_db({{"base", suspension(0), "completed", 4.0, 0.12, 2.0, 0.1},
+                {"stated", suspension(0.025), "completed", 3.0, 0.09, 16.0, 0.4},
+                {"other", suspension(0.02), "completed", 3.5, 0.09, 8.0, 0.4},
+                {"base32", at_phi(suspension(0), 0.32), "completed", 6.0, 0.12, 2.0, 0.1},
+                {"agg32", at_phi(suspension(0.025), 0.32), "completed", 5.0, 0.12, 4.0, 0.1}});
+  db::ResultsDb db(db_path, db::ResultsDb::Mode::kReadOnly);
+  const FigureSet set = write_figures(load_runs(db, std::nullopt, {}), dir_ / "figures");
+  ASSERT_TRUE(std::any_of(set.figures.begin(), set.figures.end(),
+                          [](const Figure& f) { return f.name == "drag_ratio_vs_size_ratio"; }));
+  std::ifstream gp(dir_ / "figures" / "scripts" / "drag_ratio_vs_size_ratio.gp");
+  std::stringstream script;
+  script << gp.rdbuf();
+  EXPECT_THAT(script.str(), HasSubstr("set arrow 1 from 7.6, graph 0 to 7.6, graph 1"));
+  EXPECT_THAT(script.str(), HasSubstr("(48, 0.03), (12, 0.025), (6, 0.02)"));
+  EXPECT_THAT(script.str(), Not(HasSubstr("set arrow 1 from 2.3")));  // no phi 0.12 panel
+  // the ringed points: only the stated run, at its own ratios
+  std::ifstream ringed(dir_ / "figures" / "data" / "drag_ratio_vs_size_ratio_phi0.2_stated.dat");
+  std::string line, rows;
+  while (std::getline(ringed, line)) rows += line + "\n";
+  EXPECT_EQ(rows, "8 0.75\n");
+  EXPECT_FALSE(
+      fs::exists(dir_ / "figures" / "data" / "drag_ratio_vs_size_ratio_phi0.32_stated.dat"));
+}
+
 // Issue 41, item 2: a completed run whose series.h5 was missing or damaged
 // was left out of the time-series figures without a word (exit 0, the tables
 // still listing it). Each is named with its file, the reason and the figures.
