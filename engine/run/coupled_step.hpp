@@ -86,15 +86,21 @@ struct Liquid {
   }
 
   // One collision and streaming step, where the lattice lives. On the GPU it
-  // is waited for, so that the fluid's stage time is the fluid's (the
-  // coupling's next apply() would wait for it anyway).
+  // is only launched: the sphere side of the step (velocities, lubrication,
+  // events) reads the loads the coupling's apply() already brought to the
+  // host, never the lattice, so it runs on the CPU while the GPU steps, and
+  // finish_step() waits for what is left. Every read of the device's state
+  // before that (a download, the next apply's loads) is a blocking copy on
+  // the same stream, so it sees the step complete whatever the order here.
   void step() {
-    if (device) {
+    if (device)
       device->step();
-      device->synchronize();
-    } else {
+    else
       fluid.step();
-    }
+  }
+  // Waits for the GPU's step (nothing on the CPU, where step() is complete).
+  void finish_step() {
+    if (device) device->synchronize();
   }
   // The mirror up to date with the GPU: populations and the force field.
   // Nothing to do where it already is (a sample and a checkpoint on one step:
@@ -195,6 +201,9 @@ class CoupledStep {
       stages_.run(events_stage_, [&] { contacts_.advance(s, box_, 1.0); });
     else if (modules_.spheres_move)
       stages_.run(spheres_stage_, [&] { spheres::advance_positions(s, box_); });
+    // On the GPU the fluid stage is the launch above plus what of the step the
+    // sphere side did not hide: the wait here (docs/gpu.md, "Overlap").
+    if (liquid_) stages_.run(fluid_stage_, [&] { liquid_->finish_step(); });
     return {};
   }
 
