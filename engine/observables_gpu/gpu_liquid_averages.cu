@@ -2,6 +2,7 @@
 // kernel bodies of engine/observables/liquid_average_body.hpp, and the fixed
 // order of their sums. tests/observables/liquid_average_body_test.cpp runs
 // the same blocks serially on the CPU against observables::liquid_averages.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -76,13 +77,18 @@ struct GpuLiquidAverages<Real>::Device {
 
 template <class Real>
 GpuLiquidAverages<Real>::GpuLiquidAverages() : device_(std::make_unique<Device>()) {
-  int device = 0, sms = 0;
+  int device = 0, sms = 0, per_sm = 0;
   cuda_check(cudaGetDevice(&device), "current device");
   cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
              "device attribute");
-  // four blocks per multiprocessor (the lattice's own reductions' grid): each
-  // thread then sums ~50 cells at the paper's box, enough to hide latency
-  device_->blocks = 4 * sms;
+  // One full wave: as many blocks as fit on the multiprocessors at once (3
+  // a multiprocessor on sm_90 at 72-79 registers a thread), so no block
+  // waits for a second round; each thread then sums ~30 cells at the paper's
+  // box, enough loads in flight to hide the memory's latency.
+  cuda_check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, liquid_sums_kernel<Real>,
+                                                           kLiquidSumThreads, 0),
+             "occupancy of the liquid averages");
+  device_->blocks = std::max(1, per_sm) * sms;
   cuda_check(cudaMalloc(&device_->partial, sizeof(LiquidSums) * device_->blocks),
              "cudaMalloc of the liquid averages' partial sums");
   device_->host_partial.resize(static_cast<std::size_t>(device_->blocks));

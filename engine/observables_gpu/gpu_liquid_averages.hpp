@@ -15,8 +15,9 @@
 //   sum     liquid_thread_sums per thread over a grid-stride of cells, a
 //           fixed tree per block into one LiquidSums per block; the host
 //           adds the blocks in block order.
-// Every sum has a fixed order (no atomics): the same state gives the same
-// averages on every run, whatever the scheduling. They differ from the CPU's
+// Every sum has a fixed order (no atomics): on a given GPU (the grid is
+// sized to it) the same state gives the same averages on every run, whatever
+// the scheduling. They differ from the CPU's
 // (whose OpenMP threads add rows in another order) at round-off only.
 //
 // Declared without CUDA headers; a build without CUDA has the class but its
