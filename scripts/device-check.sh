@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The device check: on a machine with a GPU, runs the GPU tests (lattice and
-# immersed boundary), the GPU fluid benchmark (with the device's copy
+# The device check: on a machine with a GPU, runs the GPU tests (lattice,
+# immersed boundary and the samples' liquid averages), the GPU fluid benchmark (with the device's copy
 # bandwidth measured in the same run), the GPU coupled-step benchmark (the
 # immersed boundary on the paper's case against the fluid alone),
 # the CPU fluid benchmark on that machine's cores for the speed-up, and the
@@ -61,7 +61,9 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
 } > "$out/machine.txt" 2>&1
 cat "$out/machine.txt"
 
-# 1. the GPU against the CPU reference (tests/lattice_gpu)
+# 1. the GPU against the CPU reference (tests/lattice_gpu; tests/coupling_gpu:
+#    the immersed boundary and the liquid averages, a 200-step suspension run
+#    on each device among them)
 step gpu-tests 50 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
 step gpu-coupling-tests 50 "$bundle/bin/test_gpu_coupling" \
   --gtest_output="json:$out/gpu-coupling-tests.json"

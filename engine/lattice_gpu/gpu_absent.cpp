@@ -59,6 +59,10 @@ DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
   return {};
 }
 template <class Real>
+DeviceForceField<const Real> GpuFluidLattice<Real>::device_force_field_if_set() const {
+  return {};
+}
+template <class Real>
 void GpuFluidLattice<Real>::step() {}
 template <class Real>
 void GpuFluidLattice<Real>::synchronize() const {}

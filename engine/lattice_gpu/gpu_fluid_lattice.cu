@@ -225,6 +225,13 @@ DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
 }
 
 template <class Real>
+DeviceForceField<const Real> GpuFluidLattice<Real>::device_force_field_if_set() const {
+  DeviceForceField<const Real> field;
+  for (int d = 0; d < 3; ++d) field.component[d] = device_->force[d];
+  return field;
+}
+
+template <class Real>
 void GpuFluidLattice<Real>::step() {
   const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
   CollisionConstants<Real> k;

@@ -65,6 +65,9 @@ class GpuFluidLattice {
   lattice::AaSlots<Real> device_slots() const;
   bool next_step_is_even() const { return time_step_ % 2 == 0; }
   DeviceForceField<Real> device_force_field();
+  // For reading (the liquid averages, engine/observables_gpu): the device
+  // force field where there is one, else null pointers; allocates nothing.
+  DeviceForceField<const Real> device_force_field_if_set() const;
 
   // One lattice-Boltzmann step: collide with the current force, stream.
   void step();

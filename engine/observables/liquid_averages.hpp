@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/lattice/forced_liquid.hpp"
+#include "engine/observables/liquid_average_body.hpp"
 #include "engine/spheres/sphere_set.hpp"
 
 namespace flocsim::observables {
@@ -35,10 +36,15 @@ struct LiquidAverages {
   double max_speed_outside_spheres = 0;
 };
 
-// `solid` is scratch space (one byte per cell), reused between calls.
+// `solid` is scratch space (one byte per cell), reused between calls. The
+// per-cell work is add_liquid_cell (liquid_average_body.hpp), which the GPU's
+// reduction shares (engine/observables_gpu).
 template <class Real>
 LiquidAverages liquid_averages(const lattice::ForcedLiquid<Real>& fluid,
                                const spheres::SphereSet& spheres, std::vector<std::uint8_t>& solid);
+
+// The averages from sums over a lattice of `cells` cells (either back-end's).
+LiquidAverages averages_from_sums(const LiquidSums& sums, long cells);
 
 // Marks (1) the cells whose centre (integer coordinates) lies within `radius`
 // of a sphere centre, periodic images included; the others 0.

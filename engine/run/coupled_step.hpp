@@ -34,6 +34,8 @@
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
 #include "engine/lubrication/radial_lubrication.hpp"
+#include "engine/observables/liquid_averages.hpp"
+#include "engine/observables_gpu/gpu_liquid_averages.hpp"
 #include "engine/run/coupling_monitor.hpp"
 #include "engine/run/timed_stages.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
@@ -51,16 +53,21 @@ inline constexpr std::string_view events = "events";
 // The liquid and its coupling to the spheres (scenes with a liquid). On a
 // GPU (`device` given: the case's "device": "cuda") the lattice steps there
 // and the immersed boundary couples the spheres to it (engine/coupling_gpu);
-// `fluid` is then the run's mirror, brought up to date by to_host() before
-// anything reads it (the observables, checkpoints, the final fields), so that
-// everything downstream is the CPU run's code unchanged.
+// the samples' liquid averages are reduced there too (averages(),
+// engine/observables_gpu), so a sample downloads no lattice. `fluid` is then
+// the run's mirror, brought up to date by to_host() before anything else
+// reads it (checkpoints and the health check before one, the final fields),
+// so that everything downstream is the CPU run's code unchanged; between
+// those it is stale, and nothing reads it.
 template <class Real>
 struct Liquid {
   lattice::FluidLattice<Real> fluid;
   std::unique_ptr<gpu::GpuFluidLattice<Real>> device;
+  std::unique_ptr<gpu::GpuLiquidAverages<Real>> device_averages;  // with `device`
   std::unique_ptr<coupling::SphereCoupling<Real>> coupling;
   spheres::SphereDynamicsSettings dynamics;
-  std::vector<std::uint8_t> solid;  // scratch of the liquid averages
+  std::vector<std::uint8_t> solid;  // scratch of the CPU's liquid averages
+  std::vector<double> centres;      // scratch of the GPU's: x y z per sphere
 
   explicit Liquid(const cases::SuspensionCase& c,
                   std::unique_ptr<gpu::GpuFluidLattice<Real>> on_gpu = nullptr)
@@ -80,6 +87,7 @@ struct Liquid {
           immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius, c.numerics.coupling,
                                                       false},
           *device);
+      device_averages = std::make_unique<gpu::GpuLiquidAverages<Real>>();
     } else {
       coupling = coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius);
     }
@@ -102,9 +110,22 @@ struct Liquid {
   void finish_step() {
     if (device) device->synchronize();
   }
+  // The liquid averages of the current state (observables/liquid_averages.hpp)
+  // with the cells inside the spheres `s` solid, where the lattice lives: on
+  // the GPU its reduction (the centres up, a partial sum per block down; the
+  // mirror is neither read nor updated), else on the lattice itself.
+  observables::LiquidAverages averages(const spheres::SphereSet& s) {
+    if (!device) return observables::liquid_averages(fluid, s, solid);
+    centres.resize(3 * s.size());
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (int d = 0; d < 3; ++d) centres[3 * i + d] = s.position[i][d];
+    return observables::averages_from_sums(device_averages->sums(*device, centres, s.radius),
+                                           device->extent().cells());
+  }
   // The mirror up to date with the GPU: populations and the force field.
-  // Nothing to do where it already is (a sample and a checkpoint on one step:
-  // the field changes only in the coupling's apply(), before a step).
+  // Nothing to do where it already is (a checkpoint, then the final fields
+  // on one step: the field changes only in the coupling's apply(), before a
+  // step).
   void to_host() {
     if (!device || fluid.time_step() == device->time_step()) return;
     device->download(fluid);

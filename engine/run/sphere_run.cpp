@@ -112,7 +112,9 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
                          .well_energy = step.contacts().well_energy(s.spheres),
                          .collisions = static_cast<double>(step.contacts().counters().collisions)};
   if (Liquid<Real>* liquid = step.liquid()) {
-    const auto l = observables::liquid_averages(liquid->fluid, s.spheres, liquid->solid);
+    // on the GPU, reduced there: the mirror (liquid->fluid) is stale here and
+    // nothing in a sample reads it (the inside momenta are the coupling's)
+    const auto l = liquid->averages(s.spheres);
     std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a, l.mass);
     if (!sick.empty()) return sick;
     if (!extremes.mass_first_set) {
@@ -257,7 +259,6 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     if (s.step % d.sample == 0) {
       {
         const auto timing = stages.time(observables_stage);
-        if (liquid) liquid->to_host();  // the GPU's lattice, where it has one
         const std::string sick = take_sample(c, step, protocol, s, slabs);
         if (!sick.empty()) return fail(sick);
       }
@@ -278,7 +279,7 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
     const bool stop_now = shell.stop_requested(s.step);
     if (!done && (stop_now || shell.checkpoint_due(s.step, c.protocol.checkpoint_every_s))) {
       // only a healthy state is checkpointed: the last good one is never replaced by a bad one
-      if (liquid) liquid->to_host();
+      if (liquid) liquid->to_host();  // the GPU's lattice, where it has one
       const std::string sick = health(s.spheres, step.box(), c.physics.lubrication_onset_over_a,
                                       liquid ? liquid->fluid.total_mass() : 0.0);
       if (!sick.empty()) return fail(sick);
