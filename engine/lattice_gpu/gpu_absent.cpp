@@ -59,6 +59,14 @@ DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
   return {};
 }
 template <class Real>
+DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field_if_set() const {
+  return {};
+}
+template <class Real>
+DeviceCoverage<Real> GpuFluidLattice<Real>::device_coverage() {
+  return {};
+}
+template <class Real>
 void GpuFluidLattice<Real>::step() {}
 template <class Real>
 void GpuFluidLattice<Real>::synchronize() const {}
