@@ -214,6 +214,9 @@ void GpuFluidLattice<Real>::download_force_field(lattice::FluidLattice<Real>& ho
   const lattice::Extent& e = host.extent();
   if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
     throw std::invalid_argument("GPU lattice: force field into a lattice of another extent");
+  // a device without a field (partially saturated cells) leaves a host
+  // without one as it is: no zero field for the observables to read
+  if (!device_->force[0] && !host.has_force_field()) return;
   const lattice::ForceFieldView<Real> field = host.force_field();
   const std::size_t count = static_cast<std::size_t>(extent_.cells());
   for (int d = 0; d < 3; ++d) {

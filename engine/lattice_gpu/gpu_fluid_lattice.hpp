@@ -68,7 +68,8 @@ class GpuFluidLattice {
   // The per-cell force field of the next steps, from the host (x fastest).
   void upload_force_field(const lattice::ForceFieldView<const Real>& field);
   // The device's force field into `host`'s (enabled there if needed; zero
-  // where the device has none): what the host's observables then read.
+  // where the device has none, unless the host has none either): what the
+  // host's observables then read.
   void download_force_field(lattice::FluidLattice<Real>& host) const;
 
   // For the couplings that work on the device (engine/coupling_gpu): the
