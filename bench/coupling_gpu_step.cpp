@@ -163,10 +163,12 @@ int main(int argc, char** argv) {
   for (const std::string& text : bench::split(options, ',')) {
     const auto scheme = bench::parse_option(text);
     if (!scheme || !scheme->immersed_boundary()) {
-      std::fprintf(stderr,
-                   "bench_coupling_gpu: option '%s': want direct:KERNEL:SPACING:SWEEPS or "
-                   "control:KERNEL:SPACING[:G:P] (the GPU has no partially saturated cells yet)\n",
-                   text.c_str());
+      std::fprintf(
+          stderr,
+          "bench_coupling_gpu: option '%s': want direct:KERNEL:SPACING:SWEEPS or "
+          "control:KERNEL:SPACING[:G:P] (partially saturated cells are not benchmarked here "
+          "yet)\n",
+          text.c_str());
       return 2;
     }
     schemes.push_back(*scheme);

@@ -97,7 +97,9 @@ std::optional<double> GpuRates::step_s(const cases::ParsedCase& c, const run::Ca
   }
   const coupling::Scheme& scheme = c.spheres.numerics.coupling;
   if (!scheme.immersed_boundary()) {
-    why = "partially saturated cells do not run on the GPU yet";
+    why =
+        "no GPU benchmark of partially saturated cells (bench_coupling_gpu measures the immersed "
+        "boundary only)";
     return std::nullopt;
   }
   const std::string option = scheme.describe();

@@ -55,13 +55,17 @@ int run_command(const RunArguments& a) {
     // the populations must fit the GPU's free memory (the host mirror is
     // checked with the case, against this machine's); the lattice takes its
     // memory before any output too, should another process take it meanwhile
-    // (a sphere scene adds the 3-component force field the immersed boundary writes)
+    // (a sphere scene adds the 3-component force field the immersed boundary
+    // writes, or the 8 numbers per cell of partially saturated cells)
     const double cells = static_cast<double>(
         parsed.fluid_scene ? parsed.fluid.size.cells() : parsed.spheres.derived.box.cells());
     const bool single = parsed.fluid_scene
                             ? parsed.fluid.precision == cases::Precision::single_precision
                             : parsed.spheres.numerics.single_precision;
-    const double bytes = (parsed.fluid_scene ? 19.0 : 22.0) * cells * (single ? 4 : 8);
+    const double per_cell = parsed.fluid_scene                                     ? 19.0
+                            : parsed.spheres.numerics.coupling.immersed_boundary() ? 22.0
+                                                                                   : 27.0;
+    const double bytes = per_cell * cells * (single ? 4 : 8);
     const double available = 0.9 * q.devices.front().free_gib * (1u << 30);
     if (bytes > available) {
       std::fprintf(stderr,

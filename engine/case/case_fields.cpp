@@ -586,8 +586,8 @@ FieldTable make_table() {
                .fallback = "cpu",
                .contexts = kEvery,
                .doc = "where the lattice steps (docs/gpu.md); `flocsim run --device` overrides it",
-               .rules = "cuda: the fluid scene, and sphere scenes with a liquid and the immersed "
-                        "boundary (not granular, not partially saturated cells); needs a CUDA "
+               .rules = "cuda: the fluid scene, and sphere scenes with a liquid (immersed "
+                        "boundary or partially saturated cells; not granular); needs a CUDA "
                         "build and a usable GPU"});
   add_sphere_fields(t);
   add_physics_fields(t);

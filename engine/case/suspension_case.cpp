@@ -503,11 +503,6 @@ void read_scheme(InputReader& num, Reading& r) {
       c.numerics.coupling = choose_scheme(num, r);
     }
   }
-  if (c.device == Device::cuda && !c.numerics.coupling.immersed_boundary())
-    throw InputError(
-        "device = \"cuda\" with numerics.coupling = \"partially-saturated\": "
-        "partially saturated cells do not run on the GPU yet (docs/gpu.md); give "
-        "numerics.coupling = \"immersed-boundary\" or device \"cpu\"");
 }
 
 // numerics.input_radius: where each scheme puts its boundary relative to its

@@ -16,6 +16,7 @@
 // touch the same slot, so cells may be stepped in any order, in parallel.
 #include "engine/lattice/d3q19.hpp"
 #include "engine/lattice/kernel_body.hpp"
+#include "engine/lattice/partially_saturated_collision.hpp"
 #include "engine/lattice/trt_collision.hpp"
 
 namespace flocsim::lattice {
@@ -80,6 +81,23 @@ FLOCSIM_KERNEL_BODY void aa_update_cell(const AaSlots<Real>& s, int x, int y, in
   Real f[d3q19::kQ];
   aa_load_cell(s, x, y, z, even, f);
   collide(f, Fx, Fy, Fz, k);
+  FLOCSIM_UNROLL
+  for (int i = 0; i < d3q19::kQ; ++i) s.base[aa_next_slot(s, i, x, y, z, even)] = f[i];
+}
+
+// The same for a cell that spheres partly cover (partially saturated cells:
+// coverage eps > 0, V = sum eps_k u_k), its collision blended with the solid
+// operator of partially_saturated_collision.hpp; leaves the density and the
+// momentum density rho u the collision saw in rho, jx, jy, jz.
+template <class Real>
+FLOCSIM_KERNEL_BODY void aa_update_covered_cell(const AaSlots<Real>& s, int x, int y, int z,
+                                                bool even, Real Fx, Real Fy, Real Fz, Real eps,
+                                                Real Vx, Real Vy, Real Vz,
+                                                const CollisionConstants<Real>& k, Real& rho,
+                                                Real& jx, Real& jy, Real& jz) {
+  Real f[d3q19::kQ];
+  aa_load_cell(s, x, y, z, even, f);
+  collide_partially_saturated(f, Fx, Fy, Fz, eps, Vx, Vy, Vz, k, rho, jx, jy, jz);
   FLOCSIM_UNROLL
   for (int i = 0; i < d3q19::kQ; ++i) s.base[aa_next_slot(s, i, x, y, z, even)] = f[i];
 }

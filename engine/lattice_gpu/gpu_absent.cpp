@@ -63,6 +63,10 @@ DeviceForceField<const Real> GpuFluidLattice<Real>::device_force_field_if_set() 
   return {};
 }
 template <class Real>
+DeviceCoverage<Real> GpuFluidLattice<Real>::device_coverage() {
+  return {};
+}
+template <class Real>
 void GpuFluidLattice<Real>::step() {}
 template <class Real>
 void GpuFluidLattice<Real>::synchronize() const {}

@@ -1,6 +1,7 @@
 // The GPU lattice's launchers: one thread per cell, a block per run of cells
 // along x (coalesced loads and stores in each direction's slot array), the
-// cell's work the shared kernel body aa_update_cell (engine/lattice/aa_cell.hpp).
+// cell's work the shared kernel body aa_update_cell (engine/lattice/aa_cell.hpp),
+// or aa_update_covered_cell where spheres partly cover the cell.
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -25,19 +26,38 @@ int threads_along_x(int nx) {
   return 32 * (warps < 16 ? warps : 16);
 }
 
-template <class Real, bool kForceField>
+// kCoverage: partially saturated cells; a cell with eps > 0 takes the
+// blended collision (the CPU blends whole rows with any covered cell, the
+// rest of such a row with eps = 0: the plain collision to round-off) and
+// leaves the density and momentum it saw for the coupling's exchange.
+template <class Real, bool kForceField, bool kCoverage>
 __global__ void aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx,
                                Real by, Real bz, const Real* __restrict__ Fx,
-                               const Real* __restrict__ Fy, const Real* __restrict__ Fz) {
+                               const Real* __restrict__ Fy, const Real* __restrict__ Fz,
+                               DeviceCoverage<Real> cover) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   if (x >= s.nx) return;
   const int y = blockIdx.y, z = blockIdx.z;
+  const long c = lattice::aa_cell_index(s, x, y, z);
   Real fx = bx, fy = by, fz = bz;
   if constexpr (kForceField) {
-    const long c = lattice::aa_cell_index(s, x, y, z);
     fx += Fx[c];
     fy += Fy[c];
     fz += Fz[c];
+  }
+  if constexpr (kCoverage) {
+    const Real eps = cover.eps[c];
+    if (eps > Real(0)) {
+      Real rho, jx, jy, jz;
+      lattice::aa_update_covered_cell(s, x, y, z, even, fx, fy, fz, eps, cover.solid_velocity[0][c],
+                                      cover.solid_velocity[1][c], cover.solid_velocity[2][c], k,
+                                      rho, jx, jy, jz);
+      cover.density[c] = rho;
+      cover.momentum[0][c] = jx;
+      cover.momentum[1][c] = jy;
+      cover.momentum[2][c] = jz;
+      return;
+    }
   }
   lattice::aa_update_cell(s, x, y, z, even, fx, fy, fz, k);
 }
@@ -91,6 +111,7 @@ struct GpuFluidLattice<Real>::Device {
   Real* populations = nullptr;
   long stride = 0;
   Real* force[3] = {nullptr, nullptr, nullptr};
+  Real* coverage = nullptr;   // 8 arrays of cells (DeviceCoverage), on first use
   double* partial = nullptr;  // reduction blocks x 4
   int reduction_blocks = 0;
   GpuDevice gpu;  // where all of it lives
@@ -98,6 +119,7 @@ struct GpuFluidLattice<Real>::Device {
   ~Device() {
     cudaFree(populations);
     for (Real* f : force) cudaFree(f);
+    cudaFree(coverage);
     cudaFree(partial);
   }
 };
@@ -192,6 +214,9 @@ void GpuFluidLattice<Real>::download_force_field(lattice::FluidLattice<Real>& ho
   const lattice::Extent& e = host.extent();
   if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
     throw std::invalid_argument("GPU lattice: force field into a lattice of another extent");
+  // a device without a field (partially saturated cells) leaves a host
+  // without one as it is: no zero field for the observables to read
+  if (!device_->force[0] && !host.has_force_field()) return;
   const lattice::ForceFieldView<Real> field = host.force_field();
   const std::size_t count = static_cast<std::size_t>(extent_.cells());
   for (int d = 0; d < 3; ++d) {
@@ -232,6 +257,27 @@ DeviceForceField<const Real> GpuFluidLattice<Real>::device_force_field_if_set() 
 }
 
 template <class Real>
+DeviceCoverage<Real> GpuFluidLattice<Real>::device_coverage() {
+  const std::size_t cells = static_cast<std::size_t>(extent_.cells());
+  if (!device_->coverage) {
+    const std::size_t bytes = sizeof(Real) * 8 * cells;
+    cuda_check(
+        cudaMalloc(&device_->coverage, bytes),
+        ("cudaMalloc of the cells' coverage (" + std::to_string(bytes >> 20) + " MiB)").c_str());
+    cuda_check(cudaMemset(device_->coverage, 0, bytes), "cudaMemset of the cells' coverage");
+  }
+  Real* const p = device_->coverage;
+  DeviceCoverage<Real> cover;
+  cover.eps = p;
+  cover.density = p + 4 * cells;
+  for (int d = 0; d < 3; ++d) {
+    cover.solid_velocity[d] = p + (1 + d) * cells;
+    cover.momentum[d] = p + (5 + d) * cells;
+  }
+  return cover;
+}
+
+template <class Real>
 void GpuFluidLattice<Real>::step() {
   const AaSlots<Real> s{device_->populations, device_->stride, extent_.nx, extent_.ny, extent_.nz};
   CollisionConstants<Real> k;
@@ -244,13 +290,25 @@ void GpuFluidLattice<Real>::step() {
   const bool even = time_step_ % 2 == 0;
   const Real bx = static_cast<Real>(body_force_.x), by = static_cast<Real>(body_force_.y),
              bz = static_cast<Real>(body_force_.z);
-  if (device_->force[0])
-    aa_step_kernel<Real, true><<<grid, threads>>>(s, even, k, bx, by, bz, device_->force[0],
-                                                  device_->force[1], device_->force[2]);
-  else
-    aa_step_kernel<Real, false>
-        <<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr, nullptr);
+  Real* const* F = device_->force;
+  const bool field = F[0] != nullptr;
+  if (cover_next_) {
+    const DeviceCoverage<Real> cover = device_coverage();
+    if (field)
+      aa_step_kernel<Real, true, true>
+          <<<grid, threads>>>(s, even, k, bx, by, bz, F[0], F[1], F[2], cover);
+    else
+      aa_step_kernel<Real, false, true>
+          <<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr, nullptr, cover);
+  } else if (field) {
+    aa_step_kernel<Real, true, false>
+        <<<grid, threads>>>(s, even, k, bx, by, bz, F[0], F[1], F[2], DeviceCoverage<Real>{});
+  } else {
+    aa_step_kernel<Real, false, false><<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr,
+                                                          nullptr, DeviceCoverage<Real>{});
+  }
   cuda_check(cudaGetLastError(), "launch of the lattice step");
+  cover_next_ = false;  // one step: the coupling asks again
   ++time_step_;
 }
 

@@ -30,6 +30,19 @@ struct DeviceForceField {
   Real* component[3] = {nullptr, nullptr, nullptr};
 };
 
+// Partially saturated cells on the device (engine/coupling_gpu): per cell,
+// x fastest, the summed coverage eps and V = sum eps_k u_k that the next
+// step's collision blends with (zero where no sphere covers the cell), and
+// the density and momentum density rho u that a covered cell's collision saw
+// (written by the step where eps > 0 only).
+template <class Real>
+struct DeviceCoverage {
+  Real* eps = nullptr;
+  Real* solid_velocity[3] = {nullptr, nullptr, nullptr};
+  Real* density = nullptr;
+  Real* momentum[3] = {nullptr, nullptr, nullptr};
+};
+
 template <class Real>
 class GpuFluidLattice {
  public:
@@ -55,7 +68,8 @@ class GpuFluidLattice {
   // The per-cell force field of the next steps, from the host (x fastest).
   void upload_force_field(const lattice::ForceFieldView<const Real>& field);
   // The device's force field into `host`'s (enabled there if needed; zero
-  // where the device has none): what the host's observables then read.
+  // where the device has none, unless the host has none either): what the
+  // host's observables then read.
   void download_force_field(lattice::FluidLattice<Real>& host) const;
 
   // For the couplings that work on the device (engine/coupling_gpu): the
@@ -68,6 +82,15 @@ class GpuFluidLattice {
   // For reading (the liquid averages, engine/observables_gpu): the device
   // force field where there is one, else null pointers; allocates nothing.
   DeviceForceField<const Real> device_force_field_if_set() const;
+  // Partially saturated cells: the coverage arrays (8 numbers per cell,
+  // allocated and zeroed on first use; whoever fills eps and V leaves them
+  // zero again after the step), and the request that the next step blend
+  // the collision of every cell with eps > 0 (partially_saturated_collision.hpp)
+  // and leave there the density and momentum it saw. That one step only.
+  DeviceCoverage<Real> device_coverage();
+  void cover_next_step() { cover_next_ = true; }
+  void cancel_cover() { cover_next_ = false; }
+  bool cover_pending() const { return cover_next_; }
 
   // One lattice-Boltzmann step: collide with the current force, stream.
   void step();
@@ -86,6 +109,7 @@ class GpuFluidLattice {
   lattice::Relaxation relaxation_;
   lattice::Vector3 body_force_;
   long time_step_ = 0;
+  bool cover_next_ = false;
   std::unique_ptr<Device> device_;
 };
 

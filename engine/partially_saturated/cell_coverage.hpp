@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/lattice/kernel_body.hpp"
+
 namespace flocsim::partially_saturated {
 
 // Fraction of the unit cube [-1/2, 1/2]^3 on the side n . x <= d of the plane
@@ -60,14 +62,17 @@ inline double cell_coverage(double rx, double ry, double rz, double a) {
 // centred at (x, y, z) from its centre. Positions come in single precision
 // (as the cells are listed); the cubic is evaluated in double, whose
 // cancellation error stays below 1e-9 where the normal is near an axis.
+// A kernel body (kernel_body.hpp): the GPU's partially saturated cells
+// (engine/coupling_gpu) evaluate the same function, one cell per thread.
 struct SphereCoverage {
   double inner2, outer2, plane;  // (a - sqrt(3)/2)^2, (a + sqrt(3)/2)^2, a - 1/(12 a)
-  explicit SphereCoverage(double a)
+  SphereCoverage() = default;
+  FLOCSIM_HD explicit SphereCoverage(double a)
       : inner2((a - 0.8660254037844386) * (a - 0.8660254037844386)),
         outer2((a + 0.8660254037844386) * (a + 0.8660254037844386)),
         plane(a - 1.0 / (12.0 * a)) {}
 
-  float operator()(float rx, float ry, float rz) const {
+  FLOCSIM_KERNEL_BODY float operator()(float rx, float ry, float rz) const {
     constexpr double kSmallest = 1e-4;
     const double x = rx, y = ry, z = rz;
     const double r2 = x * x + y * y + z * z;

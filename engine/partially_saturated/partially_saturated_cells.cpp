@@ -9,39 +9,19 @@
 #include <string>
 
 #include "engine/partially_saturated/cell_coverage.hpp"
+#include "engine/partially_saturated/covered_cell_body.hpp"
 
 namespace flocsim::partially_saturated {
 
 using spheres::Vec3;
 
 namespace {
-constexpr double kHalfDiagonal = 0.8660254037844386;  // sqrt(3) / 2
+constexpr double kHalfDiagonal = kHalfCellDiagonal;
 // Runs of cells are swept in blocks of kLanes (the row's buffers have the
 // slack for a last whole block, lattice::CoveredRow::kPad): one vector of
 // floats, two of doubles.
 constexpr int kLanes = 16;
 static_assert(lattice::CoveredRow<float>::kPad >= kLanes, "slack for a whole block");
-
-// v in [0, n) for v in [-n, 2n).
-int wrap_once(int v, int n) {
-  return v < 0 ? v + n : (v >= n ? v - n : v);
-}
-
-// The momentum that one sphere's share of a cell's solid operator gave the
-// liquid there (partially_saturated_collision.hpp): the cell's exchange
-// B (rho u_s - rho u - F), u_s = V / eps, B = min(1, eps), times the share
-// eps_k / eps of the cell's coverage that is the sphere's.
-inline void exchange_share(double eps_k, double eps, double rho, double V0, double V1, double V2,
-                           double j0, double j1, double j2, double f0, double f1, double f2,
-                           double& d0, double& d1, double& d2) {
-  const double total = eps > 0 ? eps : 1.0;  // (eps_k = 0 where eps = 0)
-  const double inv = 1.0 / total;
-  const double share = eps_k * inv * std::min(1.0, total);
-  const double rho_over = rho * inv;
-  d0 = share * (rho_over * V0 - j0 - f0);
-  d1 = share * (rho_over * V1 - j1 - f1);
-  d2 = share * (rho_over * V2 - j2 - f2);
-}
 
 // Sums of 16 rows of one chunk's lanes, q[i][0] + ... + q[i][kLanes - 1],
 // accumulated over a run's chunks. One sum per row would end every run in
@@ -105,21 +85,15 @@ PartiallySaturatedCells<Real>::PartiallySaturatedCells(double input_radius)
   if (!(input_radius >= 1.0 && input_radius <= 2000.0))
     throw std::invalid_argument("partially saturated cells: input_radius = " +
                                 std::to_string(input_radius) + ": must be in [1, 2000] dx");
-  box_ = static_cast<int>(std::ceil(2.0 * (input_radius + kHalfDiagonal))) + 3;
+  box_ = covering_box_edge(input_radius);
 }
 
 template <class Real>
 void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
                                           const spheres::SphereSet& spheres) {
   const lattice::Extent e = liquid.extent();
-  const int length[3] = {e.nx, e.ny, e.nz};
   const double reach = input_radius_ + kHalfDiagonal;
-  for (int d = 0; d < 3; ++d)
-    if (length[d] <= 2 * reach)  // else one cell could be within reach of a sphere and its image
-      throw std::invalid_argument(
-          "partially saturated cells: box length " + std::to_string(length[d]) +
-          " must exceed 2 (a_g + sqrt(3)/2) = " + std::to_string(2 * reach) +
-          " (a sphere must not cover its own periodic image)");
+  check_box_length(e, input_radius_);
   extent_ = e;
   const std::size_t n = spheres.size();
   const int B = box_;
@@ -141,13 +115,11 @@ void PartiallySaturatedCells<Real>::apply(lattice::ForcedLiquid<Real>& liquid,
   listed_.clear();
   for (std::size_t s = 0; s < n; ++s) {
     // the centre in the box, its box's lowest corner from there (unwrapped)
-    double c[3];
-    int lo[3];
-    for (int d = 0; d < 3; ++d) {
-      const double L = length[d];
-      c[d] = spheres.position[s][d] - L * std::floor(spheres.position[s][d] / L);
-      lo[d] = static_cast<int>(std::floor(c[d] - reach)) - 1;
-    }
+    const double p[3] = {spheres.position[s][0], spheres.position[s][1], spheres.position[s][2]};
+    const double none[3] = {0, 0, 0};
+    const CoveringSphere placed = covering_sphere(p, none, none, e, input_radius_);
+    const double(&c)[3] = placed.centre;
+    const int(&lo)[3] = placed.lo;
     for (int k = 0; k < B; ++k) {
       const double rz = lo[2] + k - c[2];
       const double left = reach * reach - rz * rz;

@@ -28,6 +28,7 @@
 
 #include "engine/case/suspension_case.hpp"
 #include "engine/coupling/sphere_coupling.hpp"
+#include "engine/coupling_gpu/gpu_partially_saturated.hpp"
 #include "engine/coupling_gpu/gpu_sphere_coupling.hpp"
 #include "engine/coupling_schemes/make_coupling.hpp"
 #include "engine/events/direct_interactions.hpp"
@@ -52,13 +53,13 @@ inline constexpr std::string_view events = "events";
 
 // The liquid and its coupling to the spheres (scenes with a liquid). On a
 // GPU (`device` given: the case's "device": "cuda") the lattice steps there
-// and the immersed boundary couples the spheres to it (engine/coupling_gpu);
-// the samples' liquid averages are reduced there too (averages(),
-// engine/observables_gpu), so a sample downloads no lattice. `fluid` is then
-// the run's mirror, brought up to date by to_host() before anything else
-// reads it (checkpoints and the health check before one, the final fields),
-// so that everything downstream is the CPU run's code unchanged; between
-// those it is stale, and nothing reads it.
+// and the coupling (immersed boundary or partially saturated cells) couples
+// the spheres to it (engine/coupling_gpu); the samples' liquid averages are
+// reduced there too (averages(), engine/observables_gpu), so a sample
+// downloads no lattice. `fluid` is then the run's mirror, brought up to date
+// by to_host() before anything else reads it (checkpoints and the health
+// check before one, the final fields), so that everything downstream is the
+// CPU run's code unchanged; between those it is stale, and nothing reads it.
 template <class Real>
 struct Liquid {
   lattice::FluidLattice<Real> fluid;
@@ -80,8 +81,11 @@ struct Liquid {
     dynamics.rigid_inside_liquid = c.numerics.inside_liquid == "rigid-body";
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
     if (c.numerics.coupling.immersed_boundary()) fluid.enable_force_field();
-    if (device) {
-      // the case parser lets only the immersed boundary onto a GPU
+    if (device && !c.numerics.coupling.immersed_boundary()) {
+      device->set_body_force(fluid.body_force());
+      coupling =
+          std::make_unique<gpu::GpuPartiallySaturatedCells<Real>>(c.numerics.input_radius, *device);
+    } else if (device) {
       device->set_body_force(fluid.body_force());
       coupling = std::make_unique<gpu::GpuSphereCoupling<Real>>(
           immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius, c.numerics.coupling,

@@ -174,7 +174,7 @@ std::string take_sample(const cases::SuspensionCase& c, CoupledStep<Real>& step,
 
 template <class Real>
 RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
-  // On a GPU the lattice and the immersed boundary step there (Liquid in
+  // On a GPU the lattice and its coupling step there (Liquid in
   // coupled_step.hpp); its memory is taken before the output folder is
   // touched, so a GPU that cannot hold the lattice refuses the run up front.
   std::unique_ptr<gpu::GpuFluidLattice<Real>> device = lattice_on_gpu<Real>(

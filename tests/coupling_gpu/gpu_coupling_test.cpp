@@ -4,6 +4,10 @@
 // sphere's trajectory, and a checkpoint carried from the GPU to the CPU. The
 // kernel bodies are the ones tests/immersed_boundary/marker_body_test.cpp
 // holds to the CPU coupling here; this suite checks their launch on a GPU.
+// Likewise the GPU's partially saturated cells against the CPU's
+// PartiallySaturatedCells (their bodies held to it by
+// tests/coupling/covered_cell_body_test.cpp): the steps' loads and liquid,
+// and a suspension's coupled step.
 //
 // Round-off: as marker_body_test.cpp (1e-12 of the largest magnitude in
 // double, 1e-4 in float); the GPU adds atomic additions in a varying order,
@@ -17,9 +21,11 @@
 
 #include "engine/case/case_file.hpp"
 #include "engine/coupling_gpu/gpu_immersed_boundary.hpp"
+#include "engine/coupling_gpu/gpu_partially_saturated.hpp"
 #include "engine/immersed_boundary/immersed_boundary.hpp"
 #include "engine/lattice/fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
+#include "engine/partially_saturated/partially_saturated_cells.hpp"
 #include "engine/run/coupled_step.hpp"
 #include "engine/run/sphere_run.hpp"
 #include "engine/spheres/sphere_dynamics.hpp"
@@ -115,6 +121,51 @@ TEST(GpuCoupling, DirectForcingStepsMatchTheCpuCoupling) {
 TEST(GpuCoupling, ControlForcingStepsAndCarriedStateMatchTheCpuCoupling) {
   expect_same_steps<double>(control(), 4);
   expect_same_steps<float>(control(), 4);
+}
+
+// Partially saturated cells: three spheres (two sharing cells, one across
+// the periodic wrap) moving over the steps, each step's loads and the liquid
+// after the steps on the GPU against the CPU coupling from the same liquid.
+template <class Real>
+void expect_same_partially_saturated_steps(int steps) {
+  const lattice::Extent e{32, 30, 28};
+  lattice::FluidLattice<Real> cpu_fluid(e, {0.02, 0.25}), mirror(e, {0.02, 0.25});
+  stir(cpu_fluid);
+  GpuFluidLattice<Real> gpu_fluid(e, {0.02, 0.25});
+  gpu_fluid.upload(cpu_fluid);
+  const double ag = 4.2;
+  partially_saturated::PartiallySaturatedCells<Real> cpu(ag);
+  GpuPartiallySaturatedCells<Real> gpu(ag, gpu_fluid);
+  spheres::SphereSet s = three_spheres();
+  for (int step = 0; step < steps; ++step) {
+    SCOPED_TRACE("step " + std::to_string(step));
+    cpu.apply(cpu_fluid, s);
+    cpu_fluid.step();
+    cpu.after_liquid_step(cpu_fluid, s);
+    gpu.apply(mirror, s);
+    gpu_fluid.step();
+    gpu.after_liquid_step(mirror, s);
+    expect_near_lists(gpu.force(), cpu.force(), kRoundOff<Real>, "force");
+    expect_near_lists(gpu.torque(), cpu.torque(), kRoundOff<Real>, "torque");
+    expect_near_lists(gpu.internal_momentum(), cpu.internal_momentum(), kRoundOff<Real>,
+                      "inside momentum");
+    expect_near_lists(gpu.internal_angular_momentum(), cpu.internal_angular_momentum(),
+                      kRoundOff<Real>, "inside angular momentum");
+    for (std::size_t k = 0; k < s.size(); ++k) s.position[k] += 3.0 * s.velocity[k];
+  }
+  gpu_fluid.download(mirror);
+  const auto a = testing::slots_of(cpu_fluid), b = testing::slots_of(mirror);
+  double worst = 0, scale = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    worst = std::max(worst, std::abs(static_cast<double>(a[k]) - b[k]));
+    scale = std::max(scale, std::abs(static_cast<double>(a[k])));
+  }
+  EXPECT_LE(worst, kRoundOff<Real> * scale) << "populations after " << steps << " steps";
+}
+
+TEST(GpuCoupling, PartiallySaturatedStepsMatchTheCpuCoupling) {
+  expect_same_partially_saturated_steps<double>(4);
+  expect_same_partially_saturated_steps<float>(4);
 }
 
 // A settling sphere, 400 steps of the coupled loop with the sphere equations
@@ -239,6 +290,49 @@ TEST(GpuCoupling, ASuspensionsCoupledStepFollowsTheCpuTrajectories) {
   EXPECT_LE(largest_difference(), 1e-8 * fastest)
       << "largest velocity difference after 300 steps; by step:" << growth;
   // and the liquid the observables read: the mirror brought up to date
+  gpu.liquid()->to_host();
+  EXPECT_NEAR(gpu.liquid()->fluid.total_mass(), cpu.liquid()->fluid.total_mass(),
+              1e-10 * cpu.liquid()->fluid.total_mass());
+}
+
+// The same suspension coupled by partially saturated cells, its GPU run
+// chosen by the scene's Liquid (engine/run/coupled_step.hpp) as a case on
+// "cuda" gets it: 150 steps on each device from the same placement.
+TEST(GpuCoupling, APartiallySaturatedSuspensionFollowsTheCpuTrajectories) {
+  const nlohmann::json doc = {{"scene", "suspension"},
+                              {"fidelity", "draft"},
+                              {"phi", 0.2},
+                              {"Re_inf", 24},
+                              {"du_over_Uinf", 0.03},
+                              {"precision", "double"},
+                              {"numerics", {{"U_inf", 0.03}, {"coupling", "partially-saturated"}}}};
+  cases::SuspensionCase c = cases::parse_case(doc).spheres;
+  ASSERT_FALSE(c.numerics.coupling.immersed_boundary());
+  run::TimedStages cpu_stages, gpu_stages;
+  run::CoupledStep<double> cpu(c, 0.03 * c.derived.settling_velocity, cpu_stages);
+  auto lattice = std::make_unique<GpuFluidLattice<double>>(
+      c.derived.box, lattice::Relaxation{c.numerics.viscosity, c.numerics.trt_magic});
+  run::CoupledStep<double> gpu(c, 0.03 * c.derived.settling_velocity, gpu_stages,
+                               std::move(lattice));
+  ASSERT_NE(dynamic_cast<GpuPartiallySaturatedCells<double>*>(gpu.liquid()->coupling.get()),
+            nullptr);
+  spheres::SphereSet s_cpu;
+  s_cpu.radius = c.numerics.radius_cells;
+  s_cpu.density_ratio = c.physics.density_ratio;
+  run::place_spheres(c, cases::modules_of(c.scene), cpu.box(), s_cpu);
+  spheres::SphereSet s_gpu = s_cpu;
+  gpu.liquid()->to_device();
+  double worst = 0;
+  for (int step = 1; step <= 150; ++step) {
+    ASSERT_EQ(cpu.advance(s_cpu), "") << "step " << step;
+    ASSERT_EQ(gpu.advance(s_gpu), "") << "step " << step;
+  }
+  for (std::size_t i = 0; i < s_cpu.size(); ++i)
+    worst = std::max(worst, (s_gpu.velocity[i] - s_cpu.velocity[i]).norm());
+  double fastest = 0;
+  for (const Vec3& v : s_cpu.velocity) fastest = std::max(fastest, v.norm());
+  ASSERT_GT(fastest, 1e-4) << "the spheres did not move: the comparison would prove little";
+  EXPECT_LE(worst, 1e-8 * fastest) << "largest velocity difference after 150 steps";
   gpu.liquid()->to_host();
   EXPECT_NEAR(gpu.liquid()->fluid.total_mass(), cpu.liquid()->fluid.total_mass(),
               1e-10 * cpu.liquid()->fluid.total_mass());

@@ -14,10 +14,13 @@
 
 #include "engine/case/case_file.hpp"
 #include "engine/case/fluid_case.hpp"
+#include "engine/coupling_gpu/gpu_partially_saturated.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/process/stop_signal.hpp"
+#include "engine/run/coupled_step.hpp"
 #include "engine/run/output_directory.hpp"
 #include "tests/run/scratch_dir.hpp"
 
@@ -504,10 +507,10 @@ TEST(Device, ACheckpointOrResultMovesBetweenDevices) {
   EXPECT_FALSE(resumable_under(other, cpu));
 }
 
-// A scene with a liquid and the immersed boundary may ask for the GPU (its
-// lattice and coupling run there, docs/gpu.md), recorded in the case as the
-// fluid scene's is; a scene without a liquid, or with partially saturated
-// cells (not on the GPU yet), is refused with the reason and what works.
+// A scene with a liquid, coupled by the immersed boundary or by partially
+// saturated cells, may ask for the GPU (its lattice and coupling run there,
+// docs/gpu.md), recorded in the case as the fluid scene's is; a scene without
+// a liquid is refused with the reason.
 TEST(Device, SphereScenesTakeCudaWhereTheirCouplingRunsOnTheGpu) {
   for (const char* scene : {"suspension", "fixed-array", "single-sphere"}) {
     json j = {{"scene", scene}, {"device", "cuda"}, {"fidelity", "draft"}};
@@ -526,19 +529,34 @@ TEST(Device, SphereScenesTakeCudaWhereTheirCouplingRunsOnTheGpu) {
               std::string::npos)
         << e.what();
   }
-  try {
-    cases::parse_case(json{{"scene", "suspension"},
-                           {"device", "cuda"},
-                           {"phi", 0.1},
-                           {"numerics", {{"coupling", "partially-saturated"}}}});
-    ADD_FAILURE() << "partially saturated cells accepted device cuda";
-  } catch (const input::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("partially saturated cells do not run on the GPU yet"),
-              std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("\"immersed-boundary\" or device \"cpu\""),
-              std::string::npos)
-        << e.what();
+  // Partially saturated cells run on the GPU too (engine/coupling_gpu): the
+  // case is accepted as it is; its run needs a usable GPU, and where there is
+  // none the GPU lattice is refused with the reason, before any work.
+  const json psm = {{"scene", "suspension"},
+                    {"device", "cuda"},
+                    {"phi", 0.1},
+                    {"fidelity", "draft"},
+                    {"numerics", {{"coupling", "partially-saturated"}}}};
+  const cases::ParsedCase c = cases::parse_case(psm);
+  EXPECT_EQ(c.spheres.device, cases::Device::cuda);
+  EXPECT_EQ(c.spheres.to_json()["device"], "cuda");
+  ASSERT_FALSE(c.spheres.numerics.coupling.immersed_boundary());
+  const gpu::GpuQuery gpus = gpu::query_gpus();
+  const lattice::Relaxation relaxation{c.spheres.numerics.viscosity, c.spheres.numerics.trt_magic};
+  if (gpus.devices.empty()) {
+    ASSERT_FALSE(gpus.why_none.empty());
+    try {
+      gpu::GpuFluidLattice<double> device(c.spheres.derived.box, relaxation);
+      ADD_FAILURE() << "a GPU lattice without a usable GPU";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), gpus.why_none);
+    }
+  } else {
+    Liquid<double> liquid(c.spheres, std::make_unique<gpu::GpuFluidLattice<double>>(
+                                         c.spheres.derived.box, relaxation));
+    EXPECT_NE(dynamic_cast<gpu::GpuPartiallySaturatedCells<double>*>(liquid.coupling.get()),
+              nullptr);
+    EXPECT_EQ(liquid.coupling->stage_name(), "partially_saturated");
   }
 }
 
