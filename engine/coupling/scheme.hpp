@@ -124,7 +124,7 @@ inline bool stable_gains(const ControlGains& g) {
 // them (the case reader, flocsim calibrate): the region and what happens
 // beyond it.
 inline std::string stable_gains_region() {
-  char text[200];
+  char text[320];  // the text is about 215 characters: room for any %g
   std::snprintf(text, sizeof text,
                 "outside the region where control forcing was measured stable: integral >= %g, "
                 "proportional >= 0, integral + 2 proportional <= %g (a settling sphere shakes "

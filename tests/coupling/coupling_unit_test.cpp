@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "engine/coupling/scheme.hpp"
@@ -390,6 +391,15 @@ TEST(ControlForcing, OnlyMeasuredStableGainsAreAccepted) {
   EXPECT_FALSE(coupling::stable_gains({2, 1}));
   EXPECT_FALSE(coupling::stable_gains({0.5, 0}));
   EXPECT_FALSE(coupling::stable_gains({2, -0.1}));
+}
+
+// The refusal's reason is whole: it was cut at 199 characters, losing where
+// to read why (the doc it names) and its closing parenthesis.
+TEST(ControlForcing, TheRefusalNamesTheWholeStableRegion) {
+  const std::string why = coupling::stable_gains_region();
+  EXPECT_NE(why.find("integral >= "), std::string::npos);
+  EXPECT_NE(why.find("period-2 mode at 4; docs/coupling.md)"), std::string::npos) << why;
+  EXPECT_EQ(why.back(), ')');
 }
 
 }  // namespace
