@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "engine/coupling_gpu/covered_cell_kernels.hpp"
+#include "engine/coupling_gpu/sphere_buffers.cuh"
 #include "engine/lattice_gpu/cuda_check.hpp"
 #include "engine/partially_saturated/covered_cell_body.hpp"
 
@@ -129,33 +130,19 @@ __global__ void __launch_bounds__(kThreads) clear_kernel(CoverLaunch<Real> p) {
   }
 }
 
-template <class T>
-void device_resize(T*& pointer, std::size_t& held, std::size_t wanted, const char* what) {
-  if (held >= wanted) return;
-  cudaFree(pointer);
-  pointer = nullptr;
-  held = 0;
-  cuda_check(cudaMalloc(&pointer, sizeof(T) * wanted),
-             (std::string("cudaMalloc of ") + what).c_str());
-  held = wanted;
-}
-
 }  // namespace
 
 template <class Real>
 struct CoveredCellKernels<Real>::Device {
   double *spheres = nullptr, *exchange = nullptr;  // device
   std::size_t spheres_held = 0, exchange_held = 0;
-  double *pinned_spheres = nullptr, *pinned_exchange = nullptr;  // host, page-locked
-  std::size_t pinned_held = 0;
-  std::size_t covered = 0;  // spheres of the pending or last cover()
-  bool pending = false;     // cover() queued, exchange() not yet run
+  PinnedSphereBuffers pinned;  // the covering spheres in, their exchange out
+  std::size_t covered = 0;     // spheres of the pending or last cover()
+  bool pending = false;        // cover() queued, exchange() not yet run
 
   ~Device() {
     cudaFree(spheres);
     cudaFree(exchange);
-    cudaFreeHost(pinned_spheres);
-    cudaFreeHost(pinned_exchange);
   }
 };
 
@@ -200,20 +187,10 @@ void CoveredCellKernels<Real>::cover(GpuFluidLattice<Real>& liquid,
   if (n == 0) return;
   device_resize(dev.spheres, dev.spheres_held, kCoveringNumbers * n, "the covering spheres");
   device_resize(dev.exchange, dev.exchange_held, kExchangeNumbers * n, "the spheres' exchange");
-  if (dev.pinned_held < n) {
-    cudaFreeHost(dev.pinned_spheres);
-    cudaFreeHost(dev.pinned_exchange);
-    dev.pinned_spheres = dev.pinned_exchange = nullptr;
-    dev.pinned_held = 0;
-    cuda_check(cudaMallocHost(&dev.pinned_spheres, sizeof(double) * kCoveringNumbers * n),
-               "pinned buffer of the covering spheres");
-    cuda_check(cudaMallocHost(&dev.pinned_exchange, sizeof(double) * kExchangeNumbers * n),
-               "pinned buffer of the spheres' exchange");
-    dev.pinned_held = n;
-  }
-  std::copy(spheres.begin(), spheres.begin() + kCoveringNumbers * n, dev.pinned_spheres);
-  cuda_check(cudaMemcpyAsync(dev.spheres, dev.pinned_spheres, sizeof(double) * kCoveringNumbers * n,
-                             cudaMemcpyHostToDevice),
+  dev.pinned.reserve(n, kCoveringNumbers, kExchangeNumbers, "the covering spheres");
+  std::copy(spheres.begin(), spheres.begin() + kCoveringNumbers * n, dev.pinned.to_device);
+  cuda_check(cudaMemcpyAsync(dev.spheres, dev.pinned.to_device,
+                             sizeof(double) * kCoveringNumbers * n, cudaMemcpyHostToDevice),
              "upload of the covering spheres");
   const CoverLaunch<Real> p = launch_of(liquid, input_radius_, dev.spheres, dev.exchange);
   cover_kernel<Real><<<static_cast<unsigned>(n), kThreads>>>(p);
@@ -233,11 +210,12 @@ void CoveredCellKernels<Real>::exchange(GpuFluidLattice<Real>& liquid,
   cuda_check(cudaGetLastError(), "launch of the cells' exchange");
   clear_kernel<Real><<<static_cast<unsigned>(n), kThreads>>>(p);
   cuda_check(cudaGetLastError(), "launch of the coverage's clearing");
-  cuda_check(cudaMemcpyAsync(dev.pinned_exchange, dev.exchange,
+  cuda_check(cudaMemcpyAsync(dev.pinned.from_device, dev.exchange,
                              sizeof(double) * kExchangeNumbers * n, cudaMemcpyDeviceToHost),
              "download of the spheres' exchange");
   cuda_check(cudaDeviceSynchronize(), "partially saturated cells");
-  std::copy(dev.pinned_exchange, dev.pinned_exchange + kExchangeNumbers * n, exchange.begin());
+  std::copy(dev.pinned.from_device, dev.pinned.from_device + kExchangeNumbers * n,
+            exchange.begin());
 }
 
 template <class Real>

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "engine/coupling_gpu/marker_kernels.hpp"
+#include "engine/coupling_gpu/sphere_buffers.cuh"
 #include "engine/immersed_boundary/marker_body.hpp"
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice_gpu/cuda_check.hpp"
@@ -255,19 +256,6 @@ __global__ void carried_increment_kernel(Real* increment, const Real* carried, l
   if (q < lanes) increment[q] = carried[q] * dV;
 }
 
-template <class T>
-void device_resize(T*& pointer, std::size_t& held, std::size_t wanted, const char* what) {
-  if (held >= wanted) return;
-  cudaFree(pointer);
-  pointer = nullptr;
-  held = 0;
-  cuda_check(cudaMalloc(&pointer, sizeof(T) * wanted),
-             (std::string("cudaMalloc of ") + what + " (" +
-              std::to_string((sizeof(T) * wanted) >> 20) + " MiB)")
-                 .c_str());
-  held = wanted;
-}
-
 }  // namespace
 
 template <class Real>
@@ -278,8 +266,7 @@ struct MarkerKernels<Real>::Device {
   std::size_t box_held = 0, box_force_held = 0, force_held = 0, slip_held = 0, inc_held = 0;
   double *poses = nullptr, *loads = nullptr;  // device
   std::size_t poses_held = 0, loads_held = 0;
-  double *pinned_poses = nullptr, *pinned_loads = nullptr;  // host, page-locked
-  std::size_t pinned_held = 0;
+  PinnedSphereBuffers pinned;        // the poses in, the loads out
   std::size_t spheres = 0;           // of the last apply(): the carried markers' count
   std::size_t shared_per_block = 0;  // dynamic shared memory the sphere kernel may take
 
@@ -292,8 +279,6 @@ struct MarkerKernels<Real>::Device {
     cudaFree(increment);
     cudaFree(poses);
     cudaFree(loads);
-    cudaFreeHost(pinned_poses);
-    cudaFreeHost(pinned_loads);
   }
 };
 
@@ -376,19 +361,9 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
   dev.spheres = n;
   device_resize(dev.poses, dev.poses_held, kPoseNumbers * n, "the sphere poses");
   device_resize(dev.loads, dev.loads_held, kLoadNumbers * n, "the sphere loads");
-  if (dev.pinned_held < n) {
-    cudaFreeHost(dev.pinned_poses);
-    cudaFreeHost(dev.pinned_loads);
-    dev.pinned_poses = dev.pinned_loads = nullptr;
-    dev.pinned_held = 0;
-    cuda_check(cudaMallocHost(&dev.pinned_poses, sizeof(double) * kPoseNumbers * n),
-               "pinned buffer of the poses");
-    cuda_check(cudaMallocHost(&dev.pinned_loads, sizeof(double) * kLoadNumbers * n),
-               "pinned buffer of the loads");
-    dev.pinned_held = n;
-  }
-  std::copy(poses.begin(), poses.end(), dev.pinned_poses);
-  cuda_check(cudaMemcpyAsync(dev.poses, dev.pinned_poses, sizeof(double) * kPoseNumbers * n,
+  dev.pinned.reserve(n, kPoseNumbers, kLoadNumbers, "the sphere poses and loads");
+  std::copy(poses.begin(), poses.end(), dev.pinned.to_device);
+  cuda_check(cudaMemcpyAsync(dev.poses, dev.pinned.to_device, sizeof(double) * kPoseNumbers * n,
                              cudaMemcpyHostToDevice),
              "upload of the sphere poses");
 
@@ -436,11 +411,11 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
       sphere_kernel<Real, 2, false><<<blocks, kThreads>>>(p);
   }
   cuda_check(cudaGetLastError(), "launch of the immersed boundary");
-  cuda_check(cudaMemcpyAsync(dev.pinned_loads, dev.loads, sizeof(double) * kLoadNumbers * n,
+  cuda_check(cudaMemcpyAsync(dev.pinned.from_device, dev.loads, sizeof(double) * kLoadNumbers * n,
                              cudaMemcpyDeviceToHost),
              "download of the sphere loads");
   cuda_check(cudaDeviceSynchronize(), "immersed boundary");
-  std::copy(dev.pinned_loads, dev.pinned_loads + kLoadNumbers * n, loads.begin());
+  std::copy(dev.pinned.from_device, dev.pinned.from_device + kLoadNumbers * n, loads.begin());
 }
 
 namespace {
