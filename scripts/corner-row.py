@@ -2,7 +2,8 @@
 """One row of the grid's-corners table (docs/accuracy-cost.md, "The grid's corners") from a corner
 run's result.json: outcome and steps, largest liquid speed in lattice units and in U_inf, its Mach
 number, largest sphere speed, worst overlap, mass and momentum balance, the coupling monitor's worst
-window, U/U_inf, F and C_sph with their batch-means errors, and the wall time.
+window, U/U_inf, F and C_sph with their batch-means errors, and the wall time; on stderr the case's
+numerics and what was not stationary.
 
 Usage: scripts/corner-row.py RESULT.json [ESTIMATE]
   ESTIMATE   the wall time `sweep launch` (or `sweep plan`) printed for this point, e.g. "12.1 min",
@@ -39,7 +40,8 @@ def main(argv):
           f"{o['C_sph']['mean']:.2f} | {wall_text} |")
     print(f"  ({cells} cells, nu {d['viscosity']:.4g}, tau {d['tau']:.4g}, U_inf {U_inf}, "
           f"{c['numerics'].get('immersed_boundary', 'preset IB')}, {c['precision']}, "
-          f"{cost['threads']} threads, not stationary: {', '.join(r.get('not_stationary', [])) or 'none'})")
+          f"{cost['threads']} threads, not stationary: {', '.join(r.get('not_stationary', [])) or 'none'})",
+          file=sys.stderr)  # the row alone on stdout
 
 
 if __name__ == '__main__':
