@@ -81,17 +81,19 @@ struct Liquid {
     dynamics.rigid_inside_liquid = c.numerics.inside_liquid == "rigid-body";
     fluid.set_body_force({dynamics.external.liquid_body_force.x(), 0, 0});
     if (c.numerics.coupling.immersed_boundary()) fluid.enable_force_field();
-    if (device && !c.numerics.coupling.immersed_boundary()) {
+    if (device) {
       device->set_body_force(fluid.body_force());
+      // every coupling's samples reduce the liquid on the GPU (averages())
+      device_averages = std::make_unique<gpu::GpuLiquidAverages<Real>>();
+    }
+    if (device && !c.numerics.coupling.immersed_boundary()) {
       coupling =
           std::make_unique<gpu::GpuPartiallySaturatedCells<Real>>(c.numerics.input_radius, *device);
     } else if (device) {
-      device->set_body_force(fluid.body_force());
       coupling = std::make_unique<gpu::GpuSphereCoupling<Real>>(
           immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius, c.numerics.coupling,
                                                       false},
           *device);
-      device_averages = std::make_unique<gpu::GpuLiquidAverages<Real>>();
     } else {
       coupling = coupling::make_coupling<Real>(c.numerics.coupling, c.numerics.input_radius);
     }
