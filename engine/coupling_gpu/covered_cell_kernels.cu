@@ -17,6 +17,7 @@
 // more cover one cell the order, and so the last bit of eps and V there,
 // varies from run to run. The exchange's sums add no variation of their own.
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -201,6 +202,11 @@ template <class Real>
 void CoveredCellKernels<Real>::exchange(GpuFluidLattice<Real>& liquid,
                                         std::vector<double>& exchange) {
   Device& dev = *device_;
+  // on cleared coverage the kernel would read an older step's density and
+  // momentum and give loads that look valid: refuse instead
+  if (!dev.pending)
+    throw std::logic_error(
+        "partially saturated cells on the GPU: exchange() without a cover() since the last one");
   const std::size_t n = dev.covered;
   exchange.assign(kExchangeNumbers * n, 0.0);
   dev.pending = false;

@@ -158,6 +158,7 @@ void GpuFluidLattice<Real>::upload(const lattice::FluidLattice<Real>& host) {
   const lattice::Extent& e = host.extent();
   if (e.nx != extent_.nx || e.ny != extent_.ny || e.nz != extent_.nz)
     throw std::invalid_argument("GPU lattice: upload from a lattice of another extent");
+  cover_next_ = false;  // a new state: no coverage queued for the old one applies
   std::vector<Real> slots;
   for (int i = 0; i < d3q19::kQ; ++i) {
     host.save_slots(i, slots);

@@ -69,6 +69,10 @@ struct Liquid {
   spheres::SphereDynamicsSettings dynamics;
   std::vector<std::uint8_t> solid;  // scratch of the CPU's liquid averages
   std::vector<double> centres;      // scratch of the GPU's: x y z per sphere
+  // The immersed boundary on the GPU has the spheres' loads before the step,
+  // so the sphere side runs while the GPU steps; partially saturated cells
+  // measure them during the step, so the step is waited for at once.
+  bool overlaps_sphere_side = false;
 
   explicit Liquid(const cases::SuspensionCase& c,
                   std::unique_ptr<gpu::GpuFluidLattice<Real>> on_gpu = nullptr)
@@ -90,6 +94,7 @@ struct Liquid {
       coupling =
           std::make_unique<gpu::GpuPartiallySaturatedCells<Real>>(c.numerics.input_radius, *device);
     } else if (device) {
+      overlaps_sphere_side = true;
       coupling = std::make_unique<gpu::GpuSphereCoupling<Real>>(
           immersed_boundary::ImmersedBoundarySettings{c.numerics.input_radius, c.numerics.coupling,
                                                       false},
@@ -201,7 +206,10 @@ class CoupledStep {
       Liquid<Real>& l = *liquid_;
       coupling::SphereCoupling<Real>& coupling = *l.coupling;
       stages_.run(coupling_stage_, [&] { coupling.apply(l.fluid, s); });
-      stages_.run(fluid_stage_, [&] { l.step(); });
+      stages_.run(fluid_stage_, [&] {
+        l.step();
+        if (!l.overlaps_sphere_side) l.finish_step();
+      });
       stages_.run(coupling_stage_, [&] { coupling.after_liquid_step(l.fluid, s); });
       stages_.run(spheres_stage_, [&] {
         if (modules_.spheres_move) spheres::advance_velocities(s, coupling.loads(), l.dynamics);

@@ -219,14 +219,16 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
   }
   if (liquid && liquid->device) {
     liquid->to_device();
-    log.info("lattice and immersed boundary on GPU " + std::to_string(liquid->device->gpu().index) +
-             ", " + liquid->device->gpu().name);
+    log.info("lattice and " + std::string(liquid->coupling->stage_name()) + " on GPU " +
+             std::to_string(liquid->device->gpu().index) + ", " + liquid->device->gpu().name);
   }
   log.info(
       std::string("flocsim ") + kFlocsimVersion + " " + std::string(cases::scene_name(c.scene)) +
       " scene: " + std::to_string(c.derived.sphere_count) + " spheres of radius " +
       std::to_string(c.numerics.radius_cells) +
-      (modules.liquid ? " (markers at a_g = " + std::to_string(c.numerics.input_radius) + ")"
+      (modules.liquid ? std::string(c.numerics.coupling.immersed_boundary() ? " (markers"
+                                                                            : " (covered cells") +
+                            " at a_g = " + std::to_string(c.numerics.input_radius) + ")"
                       : "") +
       " in " + std::to_string(c.derived.box.nx) + " x " + std::to_string(c.derived.box.ny) + " x " +
       std::to_string(c.derived.box.nz) + ", phi = " + std::to_string(c.derived.phi_realised) +
