@@ -56,7 +56,8 @@ int run_command(const RunArguments& a) {
     // checked with the case, against this machine's); the lattice takes its
     // memory before any output too, should another process take it meanwhile
     // (a sphere scene adds the 3-component force field the immersed boundary
-    // writes, or the 8 numbers per cell of partially saturated cells)
+    // writes, or the 8 numbers per cell of partially saturated cells, and the
+    // byte per cell of the liquid averages' solid mask)
     const double cells = static_cast<double>(
         parsed.fluid_scene ? parsed.fluid.size.cells() : parsed.spheres.derived.box.cells());
     const bool single = parsed.fluid_scene
@@ -65,7 +66,7 @@ int run_command(const RunArguments& a) {
     const double per_cell = parsed.fluid_scene                                     ? 19.0
                             : parsed.spheres.numerics.coupling.immersed_boundary() ? 22.0
                                                                                    : 27.0;
-    const double bytes = per_cell * cells * (single ? 4 : 8);
+    const double bytes = per_cell * cells * (single ? 4 : 8) + (parsed.fluid_scene ? 0 : cells);
     const double available = 0.9 * q.devices.front().free_gib * (1u << 30);
     if (bytes > available) {
       std::fprintf(stderr,
