@@ -494,10 +494,9 @@ FigureSet write_figures(const std::vector<RunSummary>& runs, const fs::path& dir
       Plot p(dir, "drag_ratio_vs_size_ratio",
              "Relative drag F/F0 against normalised aggregate size <n_a>/<n_a>0, a panel per phi, "
              "a symbol per Re_inf, error bars from the batch-means errors of both runs (Fig. 12)");
-      p.commands()
-          << "set multiplot layout 1," << by_phi.size()
-          << "\nset grid\nset xlabel '<n_a>/<n_a>_0'\nset ylabel 'F/F_0'\nset logscale x\n"
-          << "set key top right font ',9'\n";  // F/F0 falls with size: that corner is free
+      p.commands() << "set multiplot layout 1," << by_phi.size()
+                   << "\nset grid\nset xlabel '<n_a>/<n_a>_0'\nset ylabel 'F/F_0'\nset logscale x\n"
+                   << "set key top right font ',9'\n";  // F/F0 falls with size: that corner is free
       for (const auto& [phi, per_re] : by_phi) {
         std::string plots;
         int style = 5;
