@@ -31,6 +31,7 @@ namespace flocsim::gpu {
 using partially_saturated::CoveredCell;
 using partially_saturated::CoveringGeometry;
 using partially_saturated::CoveringSphere;
+using partially_saturated::unpack_covering_sphere;
 
 namespace {
 
@@ -46,16 +47,6 @@ struct CoverLaunch {
   double body[3] = {0, 0, 0};
 };
 
-__device__ CoveringSphere sphere_of(const double* p) {
-  CoveringSphere s;
-  for (int d = 0; d < 3; ++d) {
-    s.centre[d] = p[d];
-    s.lo[d] = static_cast<int>(p[3 + d]);
-  }
-  for (int q = 0; q < 6; ++q) s.motion[q] = p[6 + q];
-  return s;
-}
-
 __device__ long cell_index(const CoveringGeometry& g, const CoveredCell& c) {
   return static_cast<long>(c.x) +
          static_cast<long>(g.n[0]) * (c.y + static_cast<long>(g.n[1]) * c.z);
@@ -63,7 +54,7 @@ __device__ long cell_index(const CoveringGeometry& g, const CoveredCell& c) {
 
 template <class Real>
 __global__ void __launch_bounds__(kThreads) cover_kernel(CoverLaunch<Real> p) {
-  const CoveringSphere sphere = sphere_of(p.spheres + kCoveringNumbers * blockIdx.x);
+  const CoveringSphere sphere = unpack_covering_sphere(p.spheres + kCoveringNumbers * blockIdx.x);
   const int B = p.g.B;
   const int cells = B * B * B;  // a few thousand: int arithmetic
   for (int c = threadIdx.x; c < cells; c += blockDim.x) {
@@ -82,7 +73,7 @@ __global__ void __launch_bounds__(kThreads) cover_kernel(CoverLaunch<Real> p) {
 template <class Real>
 __global__ void __launch_bounds__(kThreads) exchange_kernel(CoverLaunch<Real> p) {
   __shared__ double shared[kExchangeNumbers][kThreads];
-  const CoveringSphere sphere = sphere_of(p.spheres + kCoveringNumbers * blockIdx.x);
+  const CoveringSphere sphere = unpack_covering_sphere(p.spheres + kCoveringNumbers * blockIdx.x);
   const int B = p.g.B;
   const int cells = B * B * B;
   double sums[kExchangeNumbers];
@@ -118,7 +109,7 @@ __global__ void __launch_bounds__(kThreads) exchange_kernel(CoverLaunch<Real> p)
 
 template <class Real>
 __global__ void __launch_bounds__(kThreads) clear_kernel(CoverLaunch<Real> p) {
-  const CoveringSphere sphere = sphere_of(p.spheres + kCoveringNumbers * blockIdx.x);
+  const CoveringSphere sphere = unpack_covering_sphere(p.spheres + kCoveringNumbers * blockIdx.x);
   const int B = p.g.B;
   const int cells = B * B * B;
   for (int c = threadIdx.x; c < cells; c += blockDim.x) {

@@ -52,6 +52,18 @@ struct CoveringSphere {
   double motion[6] = {0, 0, 0, 0, 0, 0};  // u_p, omega
 };
 
+// A CoveringSphere from the 12 numbers per sphere the GPU receives (centre,
+// corner, u_p, omega; gpu_partially_saturated.cpp packs them in this order).
+FLOCSIM_KERNEL_BODY CoveringSphere unpack_covering_sphere(const double* p) {
+  CoveringSphere s;
+  for (int d = 0; d < 3; ++d) {
+    s.centre[d] = p[d];
+    s.lo[d] = static_cast<int>(p[3 + d]);
+  }
+  for (int q = 0; q < 6; ++q) s.motion[q] = p[6 + q];
+  return s;
+}
+
 // Host side, as the CPU's apply() places a sphere.
 inline CoveringSphere covering_sphere(const double (&position)[3], const double (&velocity)[3],
                                       const double (&omega)[3], const lattice::Extent& e,

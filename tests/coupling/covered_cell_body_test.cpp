@@ -68,16 +68,6 @@ struct SerialLiquid {
   }
 };
 
-CoveringSphere sphere_of(const double* p) {  // covered_cell_kernels.cu's
-  CoveringSphere s;
-  for (int d = 0; d < 3; ++d) {
-    s.centre[d] = p[d];
-    s.lo[d] = static_cast<int>(p[3 + d]);
-  }
-  for (int q = 0; q < 6; ++q) s.motion[q] = p[6 + q];
-  return s;
-}
-
 long cell_index(const CoveringGeometry& g, const CoveredCell& c) {
   return static_cast<long>(c.x) +
          static_cast<long>(g.n[0]) * (c.y + static_cast<long>(g.n[1]) * c.z);
@@ -89,7 +79,7 @@ template <bool kCoverage, class Work>
 void for_each_cell(const CoveringGeometry& g, const std::vector<double>& spheres, Work&& work) {
   const int B = g.B, cells = B * B * B;
   for (std::size_t s = 0; s < spheres.size() / gpu::kCoveringNumbers; ++s) {
-    const CoveringSphere sphere = sphere_of(&spheres[gpu::kCoveringNumbers * s]);
+    const CoveringSphere sphere = unpack_covering_sphere(&spheres[gpu::kCoveringNumbers * s]);
     for (int c = 0; c < cells; ++c) {
       const int i = c % B, j = (c / B) % B, k = c / (B * B);
       CoveredCell cell;
