@@ -5,6 +5,7 @@
 
 #include "engine/immersed_boundary/sphere_markers.hpp"
 #include "engine/input/input_reader.hpp"
+#include "engine/partially_saturated/covered_cell_body.hpp"
 
 namespace flocsim::orchestrator {
 
@@ -60,20 +61,21 @@ GpuRates read_gpu_rates(const std::vector<std::string>& files) {
         f.force_field = r.value("force_field", false);
         f.mlups = positive(r, "MLUPS", where);
         rates.fluid.push_back(f);
-      } else if (r.contains("immersed_boundary_ms")) {  // bench_coupling_gpu
+      } else if (r.contains("coupling_ms")) {  // bench_coupling_gpu
         GpuCouplingRate c;
         c.single_precision = precision_of(r, where);
         if (!r.contains("option") || !r["option"].is_string())
           throw input::InputError(where + ".option: missing or not a string");
         c.option = r["option"];
         c.fluid_mlups = positive(r, "fluid_MLUPS", where);
-        c.immersed_boundary_ms = positive(r, "immersed_boundary_ms", where);
-        c.markers = positive(r, "spheres", where) * positive(r, "markers_per_sphere", where);
+        c.coupling_ms = positive(r, "coupling_ms", where);
+        const char* per_sphere =
+            r.contains("markers_per_sphere") ? "markers_per_sphere" : "cube_cells_per_sphere";
+        c.work = positive(r, "spheres", where) * positive(r, per_sphere, where);
         rates.coupling.push_back(c);
       } else {
-        throw input::InputError(where +
-                                ": neither a fluid result (MLUPS) nor a coupled-step result "
-                                "(immersed_boundary_ms)");
+        throw input::InputError(
+            where + ": neither a fluid result (MLUPS) nor a coupled-step result (coupling_ms)");
       }
     }
   }
@@ -96,21 +98,19 @@ std::optional<double> GpuRates::step_s(const cases::ParsedCase& c, const run::Ca
     return std::nullopt;
   }
   const coupling::Scheme& scheme = c.spheres.numerics.coupling;
-  if (!scheme.immersed_boundary()) {
-    why =
-        "no GPU benchmark of partially saturated cells (bench_coupling_gpu measures the immersed "
-        "boundary only)";
-    return std::nullopt;
+  const double a_g = c.spheres.numerics.input_radius;
+  double per_sphere = 0;
+  if (scheme.immersed_boundary()) {
+    per_sphere = immersed_boundary::marker_count(a_g, scheme.marker_spacing);
+  } else {
+    const double edge = partially_saturated::covering_box_edge(a_g);
+    per_sphere = edge * edge * edge;
   }
   const std::string option = scheme.describe();
   for (const GpuCouplingRate& r : coupling)
-    if (r.single_precision == size.single_precision && r.option == option) {
-      const double markers =
-          static_cast<double>(size.spheres) *
-          immersed_boundary::marker_count(c.spheres.numerics.input_radius, scheme.marker_spacing);
+    if (r.single_precision == size.single_precision && r.option == option)
       return static_cast<double>(size.cells) / (r.fluid_mlups * 1e6) +
-             r.immersed_boundary_ms * 1e-3 * markers / r.markers;
-    }
+             r.coupling_ms * 1e-3 * static_cast<double>(size.spheres) * per_sphere / r.work;
   why = std::string("no coupled-step benchmark of ") + option + " in " + precision + " in " + file;
   return std::nullopt;
 }

@@ -9,9 +9,12 @@
 //   fluid scene:   cells / (the fluid benchmark's MLUPS, same precision and
 //                  forcing);
 //   sphere scene:  cells / (the coupled benchmark's fluid MLUPS) + its
-//                  immersed-boundary milliseconds scaled by markers in all
-//                  (N x markers per sphere) against the benchmark's, same
-//                  precision and scheme.
+//                  coupling milliseconds (the coupled step's time less the
+//                  fluid's) scaled by the coupling's work against the
+//                  benchmark's, same precision and scheme. The work is N x
+//                  markers per sphere for the immersed boundary, N x the
+//                  cells of the cube each sphere covers for partially
+//                  saturated cells.
 // Both parts scale linearly on a GPU once a box has millions of cells and the
 // spheres fill its multiprocessors many times over (the paper's case: 6 M
 // cells, 1320 blocks of 256 threads on 132 multiprocessors); far smaller
@@ -35,8 +38,8 @@ struct GpuCouplingRate {
   bool single_precision = true;
   std::string option;  // coupling::Scheme::describe()
   double fluid_mlups = 0;
-  double immersed_boundary_ms = 0;
-  double markers = 0;  // spheres x markers per sphere of the benchmark
+  double coupling_ms = 0;  // the coupled step's milliseconds less the fluid's
+  double work = 0;         // spheres x (markers or covered cube cells) per sphere
 };
 
 struct GpuRates {
@@ -45,7 +48,7 @@ struct GpuRates {
   std::vector<GpuCouplingRate> coupling;
 
   // Seconds per step of `c` on this GPU; empty with `why` set where the file
-  // has no figure for it (another precision, scheme or coupling method).
+  // has no figure for it (another precision or coupling scheme).
   std::optional<double> step_s(const cases::ParsedCase& c, const run::CaseSize& size,
                                std::string& why) const;
 };

@@ -374,9 +374,9 @@ SweepPlan plan_sweep(const SweepSpec& spec, const PlanOptions& o) {
   if (o.gpu && std::any_of(plan.runs.begin(), plan.runs.end(),
                            [](const PlannedRun& r) { return r.gpu_step_s && r.size.spheres > 0; }))
     plan.notes.push_back(
-        "sphere scenes do not run on the GPU yet (docs/gpu.md): their GPU figures project the "
-        "benchmark's coupled step (the immersed boundary and the lattice on the GPU, the sphere "
-        "side on the CPU) onto each configuration");
+        "sphere scenes' GPU figures project the benchmark's coupled step (the coupling and the "
+        "lattice on the GPU) onto each configuration; the sphere side (on the CPU while the GPU "
+        "steps, about 1 ms a step at N = 1320 on 2 cores; docs/gpu.md) is not in them");
   const double memory = cases::physical_memory_bytes();
   if (o.backend == "local" && memory > 0 && lanes * plan.memory_per_run_max > 0.8 * memory)
     plan.notes.push_back(std::to_string(lanes) + " runs at once need about " +

@@ -148,8 +148,8 @@ TEST(SweepPlan, TimesTheRealStepAndWeighsTheLatticesStorage) {
 // bench_fluid_gpu write them) give each configuration's seconds per step by
 // the model of orchestrator/gpu_rates.hpp, worked here by hand: the paper's
 // case at the paper preset (288 x 144 x 144, N = 1320) on a GPU whose fluid
-// runs at 8000 MLUPS beside the coupling and whose immersed boundary takes
-// 1.5 ms for 1320 x 900 markers.
+// runs at 8000 MLUPS beside the coupling and whose immersed boundary adds
+// 1.5 ms to the step for 1320 x 900 markers.
 TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
   const std::string dir = ::testing::TempDir() + "/plan-gpu-rate";
   std::filesystem::create_directories(dir);
@@ -162,7 +162,7 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
                            {{{"option", scheme.describe()},
                              {"precision", single ? "float" : "double"},
                              {"fluid_MLUPS", 8000.0},
-                             {"immersed_boundary_ms", 1.5},
+                             {"coupling_ms", 1.5},
                              {"spheres", 1320},
                              {"markers_per_sphere", 900}}}}};
   const std::string file = dir + "/bench-coupling-gpu.json";
@@ -208,6 +208,49 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
               HasSubstr("not on the GPU: no coupled-step benchmark of " + scheme.describe()));
 }
 
+// Partially saturated cells have no markers: their cost grows with the cells
+// each sphere covers. By hand: the demo-sized case below, a = 4 dx (a_g = a
+// for this coupling), covers a cube of edge ceil(2 (4 + sqrt(3)/2)) + 3 = 13
+// cells per sphere, 2197; a benchmark that added 2 ms for 1320 spheres of
+// a = 6 (edge ceil(2 (6 + 0.866)) + 3 = 17, 4913 cells) gives this case
+// cells / (fluid MLUPS) + 2 ms x (N x 2197) / (1320 x 4913). (The calibrated
+// a_g at a = 4 is 4.017; any a_g in (3.634, 4.134] gives edge 13.)
+TEST(SweepPlan, AGpuBenchmarkOfPartiallySaturatedCellsScalesWithTheCoveredCells) {
+  const std::string dir = ::testing::TempDir() + "/plan-gpu-rate-psm";
+  std::filesystem::create_directories(dir);
+  orc::SweepSpec spec = paper_grid("draft");
+  spec.base["numerics"] = {{"coupling", "partially-saturated"}};
+  spec.axes = {orc::Axis{"phi", {nlohmann::json(0.12)}}, orc::Axis{"Re_inf", {nlohmann::json(12)}},
+               orc::Axis{"du_over_Uinf", {nlohmann::json(0)}}};
+  const auto first = flocsim::cases::parse_case(orc::expand(spec).front().case_json);
+  const flocsim::coupling::Scheme& scheme = first.spheres.numerics.coupling;
+  ASSERT_FALSE(scheme.immersed_boundary());
+  ASSERT_GT(first.spheres.numerics.input_radius, 3.634);
+  ASSERT_LE(first.spheres.numerics.input_radius, 4.134);
+  const bool single = first.spheres.numerics.single_precision;
+  const nlohmann::json bench = {{"gpu", "NVIDIA H200 (test figures)"},
+                                {"results",
+                                 {{{"option", scheme.describe()},
+                                   {"precision", single ? "float" : "double"},
+                                   {"fluid_MLUPS", 9000.0},
+                                   {"coupling_ms", 2.0},
+                                   {"spheres", 1320},
+                                   {"cube_cells_per_sphere", 4913}}}}};
+  const std::string file = dir + "/bench-coupling-gpu.json";
+  std::ofstream(file) << bench.dump(2);
+  const orc::GpuRates rates = orc::read_gpu_rates({file});
+  orc::PlanOptions o;
+  o.measure_steps = 0;
+  o.gpu = &rates;
+  const orc::SweepPlan plan = orc::plan_sweep(spec, o);
+  ASSERT_EQ(plan.runs.size(), 1u);
+  const orc::PlannedRun& r = plan.runs.front();
+  ASSERT_TRUE(r.refused.empty()) << r.refused;
+  const double step = r.size.cells / 9000e6 + 2e-3 * r.size.spheres * 2197.0 / (1320.0 * 4913.0);
+  ASSERT_TRUE(r.wall_min_s);
+  EXPECT_NEAR(*r.wall_min_s, step * r.size.steps_min, 1e-9 * *r.wall_min_s);
+}
+
 TEST(SweepPlan, RefusesAGpuRateFileThatIsNotABenchmarksOutput) {
   const std::string dir = ::testing::TempDir() + "/plan-gpu-rate-bad";
   std::filesystem::create_directories(dir);
@@ -227,7 +270,7 @@ TEST(SweepPlan, RefusesAGpuRateFileThatIsNotABenchmarksOutput) {
   EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "half", "MLUPS": 3}]})"),
               HasSubstr("results[0].precision: must be \"float\" or \"double\""));
   EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "float", "option": "x",
-                         "fluid_MLUPS": 1, "immersed_boundary_ms": 1, "spheres": 0,
+                         "fluid_MLUPS": 1, "coupling_ms": 1, "spheres": 0,
                          "markers_per_sphere": 9}]})"),
               HasSubstr("results[0].spheres = 0: must be a positive finite number"));
   EXPECT_THAT(refusal(R"({"gpu": "G", "results": [{"precision": "float"}]})"),
