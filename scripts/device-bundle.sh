@@ -5,12 +5,16 @@
 # the CUDA back-end, and every shared library they load except the C library
 # and the loader, which the machine has (and the CUDA driver, which is its own).
 # Usage: scripts/device-bundle.sh [BUILD_DIR] [BUNDLE_DIR]
-#   defaults: build/release  build/device-bundle
+#   defaults: build/device  build/device-bundle
+# Build first with the device preset (x86-64-v3: the GPU machine's processor
+# is not known here, and a native build may stop there with "Illegal
+# instruction"):
+#   cmake --preset device && cmake --build --preset device -j 2
 # Then, on the GPU machine, from the repository root:
 #   scripts/device-check.sh build/device-bundle "$OUT"
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=${1:-build/release}
+build=${1:-build/device}
 bundle=${2:-build/device-bundle}
 programs=(
   "$build/tests/lattice_gpu/test_gpu_lattice"
@@ -22,7 +26,8 @@ programs=(
 )
 for p in "${programs[@]}"; do
   if [[ ! -x $p ]]; then
-    echo "device-bundle: $p is missing: build first (cmake --build --preset release)" >&2
+    echo "device-bundle: $p is missing: build first (cmake --preset device &&" \
+         "cmake --build --preset device -j 2)" >&2
     exit 2
   fi
 done
@@ -33,21 +38,36 @@ fi
 rm -rf "$bundle.tmp"
 mkdir -p "$bundle.tmp/bin" "$bundle.tmp/lib"
 cp "${programs[@]}" "$bundle.tmp/bin/"
-# libraries: everything ldd resolves, less the C library and the loader
+# libraries: everything ldd resolves, less the C library and the libraries
+# that come with it (they must match the machine's own C library: some use its
+# private symbols) and the CUDA driver, which is the machine's own
 for p in "${programs[@]}"; do
   ldd "$p" | awk '/=> \// {print $3}'
 done | sort -u | while read -r lib; do
   case "$(basename "$lib")" in
-    libc.so.*|libm.so.*|ld-linux*|libpthread.so.*|libdl.so.*|librt.so.*|libcuda.so.*) ;;
+    libc.so.*|libm.so.*|ld-linux*|libpthread.so.*|libdl.so.*|librt.so.*|libresolv.so.*|\
+      libnsl.so.*|libutil.so.*|libanl.so.*|libmvec.so.*|libnss_*|libcuda.so.*) ;;
     *) cp -L "$lib" "$bundle.tmp/lib/" ;;
   esac
 done
-# A native build (FLOCSIM_NATIVE, the default) runs only on processors with
-# this one's vector instructions: the device check compares before it starts.
-if grep -q "FLOCSIM_NATIVE:BOOL=ON" "$build/CMakeCache.txt"; then
+# The vector instructions the build assumed, which the device check looks for
+# in the processor before it starts: a native build's are this processor's
+# (more than any other may have); the device preset's are x86-64-v3's.
+march=$(sed -n 's/^FLOCSIM_MARCH:STRING=//p' "$build/CMakeCache.txt")
+if [[ $march == x86-64-v3 ]]; then
+  echo "avx avx2 fma bmi1 bmi2 f16c movbe" | tr ' ' '\n' > "$bundle.tmp/cpu-flags.txt"
+elif [[ -n $march ]]; then
+  echo "device-bundle: FLOCSIM_MARCH=$march: no flag list for it; the device check will not" \
+       "check the processor" >&2
+elif grep -q "FLOCSIM_NATIVE:BOOL=ON" "$build/CMakeCache.txt"; then
+  echo "device-bundle: $build is a native build: it runs only on processors with every vector" \
+       "instruction of this one; the device preset (x86-64-v3) is the safe build to carry" >&2
   grep -o -w "avx[0-9a-z_]*\|fma\|f16c\|bmi[12]\|vpclmulqdq\|gfni\|vaes" /proc/cpuinfo |
     sort -u > "$bundle.tmp/cpu-flags.txt"
 fi
+# what was packed, for the device check's machine.txt
+echo "$(git rev-parse --short HEAD 2> /dev/null)$(git diff --quiet 2> /dev/null || echo +changes)" \
+  "march=${march:-native?} $(nvcc --version 2> /dev/null | tail -n 1)" > "$bundle.tmp/build.txt"
 strip --strip-unneeded "$bundle.tmp"/bin/* 2>/dev/null || true
 rm -rf "$bundle"
 mv "$bundle.tmp" "$bundle"

@@ -1,27 +1,42 @@
 #!/usr/bin/env bash
 # The device check: on a machine with a GPU, runs the GPU tests (lattice,
-# immersed boundary, partially saturated cells and the samples' liquid averages), the GPU fluid benchmark (with the device's copy
-# bandwidth measured in the same run), the GPU coupled-step benchmark (the
-# immersed boundary on the paper's case against the fluid alone),
-# the CPU fluid benchmark on that machine's cores for the speed-up, and the
-# fluid scene at the paper's box size on the GPU and on the CPU, writing every
-# figure into one folder. Sized to finish in under 8 minutes, so a 15-minute
-# device session holds it and a rerun.
+# immersed boundary, partially saturated cells and the samples' liquid
+# averages), the GPU fluid benchmark (with the device's copy bandwidth measured
+# in the same run), the GPU coupled-step benchmark (each coupling on the
+# paper's case against the fluid alone), the CPU fluid benchmark on that
+# machine's cores for the speed-up, and the fluid scene and the paper's case at
+# the paper's box size on the GPU and on the CPU, writing every figure into one
+# folder. Sized to finish in under 8 minutes, so a 15-minute device session
+# holds it and a rerun.
 #
-# Time limits per step: 50 + 55 + 85 + 80 + 40 + 4 x 25 + 2 x 35 = 480 s at most.
+# Time limits per step: 50 + 55 + 85 + 80 + 40 + 4 x 25 + 2 x 35 = 480 s at
+# most, each with 15 s more for a step that ignores SIGTERM (a hung kernel).
 # Usage (from the repository root, on the GPU machine):
 #   scripts/device-check.sh [BUNDLE] [OUT]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
 #     OUT:    where the figures go (default $OUT, else device-check-out)
+# The device tool brings back at most 8 files of 16 MiB from OUT, so every log,
+# result and benchmark file is written to a scratch folder beside the bundle and
+# OUT gets three: summary.txt and machine.txt (kept current as steps run) and
+# device-check.tgz (the scratch folder without checkpoints) at the end.
 # Exit 0 when every step ran and every GPU test passed; 1 otherwise (each
-# step's log says which).
+# step's log says which); 2 when the bundle is missing.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-bundle=$(realpath "${1:-build/device-bundle}")
 out=${2:-${OUT:-device-check-out}}
 mkdir -p "$out"
 out=$(realpath "$out")
+bundle=${1:-build/device-bundle}
+if [[ ! -x $bundle/bin/flocsim ]]; then
+  echo "device-check: no bundle at $bundle (bin/flocsim missing): pack one with" \
+       "scripts/device-bundle.sh here and carry it" | tee "$out/summary.txt"
+  exit 2
+fi
+bundle=$(realpath "$bundle")
+work="$root/device-check-work"  # everything but the summary; tarred into $out at the end
+rm -rf "$work"
+mkdir -p "$work"
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export FLOCSIM_EXE="$bundle/bin/flocsim" FLOCSIM_SOURCE_DIR="$root"
 export OMP_WAIT_POLICY=passive
@@ -29,59 +44,85 @@ status=0
 ok_codes="0"  # the exit codes a step may end with
 started=$(date +%s)
 
-# binaries built for the build machine's vector instructions (FLOCSIM_NATIVE)
-# stop with "Illegal instruction" on a processor without them: say so first
+# what the machine is, before anything can fail: enough to diagnose a failure
+# from OUT alone
+{
+  date -u
+  nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version --format=csv
+  nvidia-smi
+  nproc
+  lscpu | grep -i "model name"
+  grep -m1 "^flags" /proc/cpuinfo
+  ldd --version | head -n 1
+  grep -E "^(PRETTY_NAME|VERSION)=" /etc/os-release
+  nvcc --version | tail -n 2
+  echo "bundle: $(cat "$bundle/build.txt" 2> /dev/null)"
+} > "$out/machine.txt" 2>&1
+cat "$out/machine.txt"
+
+pack() {  # the scratch folder into OUT, without checkpoints (each about 1 GB)
+  tar czf "$out/device-check.tgz" --exclude='*.h5' -C "$work" . 2> /dev/null
+  ls -la "$out"
+}
+
+# Binaries built for vector instructions this processor lacks stop with
+# "Illegal instruction": say so first (device-bundle.sh lists what the build
+# assumed; the default device build assumes x86-64-v3, AVX2).
 if [[ -f $bundle/cpu-flags.txt ]]; then
   for flag in $(cat "$bundle/cpu-flags.txt"); do
     if ! grep -q -w "$flag" /proc/cpuinfo; then
       echo "device-check: this processor lacks $flag, which the bundle was built for; build" \
-           "with -DFLOCSIM_NATIVE=OFF and pack that build (scripts/device-bundle.sh BUILD_DIR)" \
-        | tee "$out/summary.txt"
+           "the device preset with a lower -march and pack that build" | tee -a "$out/summary.txt"
       exit 1
     fi
   done
+fi
+
+# Every shared library the programs need must resolve from the bundle or the
+# machine (the C library's version among them).
+ldd "$bundle"/bin/* > "$work/ldd.txt" 2>&1
+if grep -E "not found" "$work/ldd.txt" | tee -a "$out/summary.txt" | grep -q .; then
+  echo "device-check: unresolved libraries above (ldd.txt in device-check.tgz)" |
+    tee -a "$out/summary.txt"
+  pack
+  exit 1
 fi
 
 step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit code
   local name=$1 limit=$2
   shift 2
   echo "== $name ($(($(date +%s) - started)) s in)" | tee -a "$out/summary.txt"
-  timeout "$limit" "$@" > "$out/$name.log" 2>&1
+  # line-buffered, so a step killed at its limit leaves what it printed; -k:
+  # a step stuck in a kernel ignores SIGTERM (it is checked between steps)
+  timeout -k 15 "$limit" stdbuf -oL -eL "$@" > "$work/$name.log" 2>&1
   local rc=$?
   echo "   exit $rc" | tee -a "$out/summary.txt"
-  tail -n 25 "$out/$name.log"
+  tail -n 25 "$work/$name.log"
   [[ " $ok_codes " == *" $rc "* ]] || status=1
 }
 
-{
-  date -u
-  nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version --format=csv
-  nproc
-  lscpu | grep -i "model name"
-} > "$out/machine.txt" 2>&1
-cat "$out/machine.txt"
 
 # 1. the GPU against the CPU reference (tests/lattice_gpu; tests/coupling_gpu:
 #    the immersed boundary and the liquid averages, a 200-step suspension run
 #    on each device among them)
-step gpu-tests 50 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$out/gpu-tests.json"
+step gpu-tests 50 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$work/gpu-tests.json"
 step gpu-coupling-tests 55 "$bundle/bin/test_gpu_coupling" \
-  --gtest_output="json:$out/gpu-coupling-tests.json"
+  --gtest_output="json:$work/gpu-coupling-tests.json"
 
 # 2. the fluid kernel: paper's box and 256^3, float and double, against the
 #    device's copy bandwidth
 step bench-fluid-gpu 85 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
-  --json "$out/bench-fluid-gpu.json"
+  --json "$work/bench-fluid-gpu.json"
 
 # 2b. the coupled step on the paper's case (a = 6, N = 1320): the immersed
 #     boundary's presets' schemes, float and double, against the fluid alone
 step bench-coupling-gpu 80 "$bundle/bin/bench_coupling_gpu" --reps 5 --steps 20 \
-  --json "$out/bench-coupling-gpu.json"
+  --json "$work/bench-coupling-gpu.json"
 
 # 3. the CPU kernel on this machine's cores at 256^3, the GPU's second box,
 #    for the speed-up
 step bench-fluid-cpu 40 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
-  --size 256 --precision all --forcing uniform --json "$out/bench-fluid-cpu.json"
+  --size 256 --precision all --forcing uniform --json "$work/bench-fluid-cpu.json"
 
 # 4. the fluid scene at the paper's box (288 x 144 x 144): a shear wave with
 #    a body force, float and double, on the GPU; and on the CPU for the ratio
@@ -89,14 +130,14 @@ for precision in float double; do
   for device in cuda cpu; do
     steps=4000
     [[ $device == cpu ]] && steps=100
-    cat > "$out/paper-box-$precision-$device.json" <<CASE
+    cat > "$work/paper-box-$precision-$device.json" <<CASE
 {"scene": "fluid", "precision": "$precision", "device": "$device",
  "fluid": {"size": [288, 144, 144], "viscosity": 0.01, "body_force": [1e-7, 0, 0],
            "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
  "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
 CASE
     step "run-paper-box-$precision-$device" 25 "$bundle/bin/flocsim" run \
-      "$out/paper-box-$precision-$device.json" --out "$out/run-paper-box-$precision-$device" --quiet
+      "$work/paper-box-$precision-$device.json" --out "$work/run-paper-box-$precision-$device" --quiet
   done
 done
 
@@ -104,7 +145,7 @@ done
 #    288 x 144 x 144, N = 1320) on the GPU for 1500 steps (5 a/U_inf), and
 #    on the CPU for 30, stopped as if by SIGTERM (exit 3, a checkpoint): their
 #    logs give the full step's rate on each, run.log the modules' split
-cat > "$out/paper-case.json" <<CASE
+cat > "$work/paper-case.json" <<CASE
 {"scene": "suspension", "fidelity": "paper", "phi": 0.2, "Re_inf": 12, "du_over_Uinf": 0.025,
  "density_ratio": 4.0, "delta_over_a": 0.025, "protocol": {"progress_every_s": 5}}
 CASE
@@ -112,10 +153,11 @@ for device in cuda cpu; do
   steps=1500
   [[ $device == cpu ]] && steps=30
   ok_codes="0 3"  # a stop on request exits 3: that is this step's success
-  step "run-paper-case-$device" 35 "$bundle/bin/flocsim" run "$out/paper-case.json" \
-    --out "$out/run-paper-case-$device" --device "$device" --stop-after "$steps" --quiet
+  step "run-paper-case-$device" 35 "$bundle/bin/flocsim" run "$work/paper-case.json" \
+    --out "$work/run-paper-case-$device" --device "$device" --stop-after "$steps" --quiet
   ok_codes="0"
 done
 
 echo "== done in $(($(date +%s) - started)) s, status $status" | tee -a "$out/summary.txt"
+pack
 exit $status

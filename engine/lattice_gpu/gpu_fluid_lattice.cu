@@ -30,8 +30,11 @@ int threads_along_x(int nx) {
 // blended collision (the CPU blends whole rows with any covered cell, the
 // rest of such a row with eps = 0: the plain collision to round-off) and
 // leaves the density and momentum it saw for the coupling's exchange.
+// At most 512 threads a block (threads_along_x): the bound makes the compiler
+// keep to the 128 registers a thread that this allows (the double covered
+// step needs 126), rather than fail at launch on a row longer than 480 cells.
 template <class Real, bool kForceField, bool kCoverage>
-__global__ void aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx,
+__global__ void __launch_bounds__(512) aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx,
                                Real by, Real bz, const Real* __restrict__ Fx,
                                const Real* __restrict__ Fy, const Real* __restrict__ Fz,
                                DeviceCoverage<Real> cover) {
@@ -240,12 +243,21 @@ template <class Real>
 DeviceForceField<Real> GpuFluidLattice<Real>::device_force_field() {
   const std::size_t bytes = sizeof(Real) * static_cast<std::size_t>(extent_.cells());
   DeviceForceField<Real> field;
-  for (int d = 0; d < 3; ++d) {
-    if (!device_->force[d]) {
-      cuda_check(cudaMalloc(&device_->force[d], bytes), "cudaMalloc of the force field");
-      cuda_check(cudaMemset(device_->force[d], 0, bytes), "cudaMemset of the force field");
+  try {
+    for (int d = 0; d < 3; ++d) {
+      if (!device_->force[d]) {
+        cuda_check(cudaMalloc(&device_->force[d], bytes), "cudaMalloc of the force field");
+        cuda_check(cudaMemset(device_->force[d], 0, bytes), "cudaMemset of the force field");
+      }
+      field.component[d] = device_->force[d];
     }
-    field.component[d] = device_->force[d];
+  } catch (...) {
+    // all three components or none: the step reads the field when the first is set
+    for (Real*& component : device_->force) {
+      cudaFree(component);
+      component = nullptr;
+    }
+    throw;
   }
   return field;
 }

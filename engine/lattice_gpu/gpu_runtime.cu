@@ -18,10 +18,12 @@ GpuQuery query_gpus() {
   int count = 0;
   const cudaError_t status = cudaGetDeviceCount(&count);
   if (status != cudaSuccess || count == 0) {
-    // without a driver the runtime says its version is "insufficient"
+    // without a driver, or with one older than this runtime (CUDA 13 wants
+    // driver 580 or newer), the runtime says the driver is "insufficient"
     const bool no_driver = status == cudaErrorInsufficientDriver;
     q.why_none =
-        std::string(no_driver ? "no NVIDIA driver on this machine"
+        std::string(no_driver ? "no NVIDIA driver on this machine, or one too old for the CUDA "
+                                "runtime flocsim was built with (CUDA 13: driver 580 or newer)"
                               : "no CUDA GPU is visible to this process") +
         " (CUDA: " + (status != cudaSuccess ? cudaGetErrorString(status) : "no device found") + ")";
     if (const char* visible = std::getenv("CUDA_VISIBLE_DEVICES"))
