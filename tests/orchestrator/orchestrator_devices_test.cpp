@@ -1,0 +1,126 @@
+// Sweeps on GPUs: the local pool gives each worker its own GPU where there are
+// several (CUDA_VISIBLE_DEVICES) and shares them beyond; CPU sweeps ask for
+// none; Slurm tasks of a cuda sweep ask for one (--gres). Fixture:
+// orchestrator_fixture.hpp.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "db/results_db.hpp"
+#include "engine/lattice_gpu/gpu_runtime.hpp"
+#include "harness.hpp"
+#include "orchestrator/local_pool.hpp"
+#include "orchestrator/plan.hpp"
+#include "orchestrator/sweep.hpp"
+#include "orchestrator_fixture.hpp"
+
+namespace fs = std::filesystem;
+using flocsim::db::ResultsDb;
+using flocsim::db::RunState;
+using nlohmann::json;
+namespace t = flocsim::test;
+
+using flocsim::test::orchestrator_fixture::Orchestrator;
+
+namespace {
+
+TEST_F(Orchestrator, WorkersOnCudaGetTheirOwnGpuThenShare) {
+  // The pool on two GPUs with three workers at once (six runs, each long
+  // enough that the three overlap): every worker is told --device cuda, the
+  // first two get GPUs 0 and 1, and the third shares one. The command line
+  // refuses --device cuda where no GPU is usable, so this drives the pool
+  // itself, as `sweep launch` does once the GPUs are counted.
+  const flocsim::orchestrator::SweepSpec spec =
+      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2, 3, 4, 5, 6}, 6, 50));
+  ResultsDb db(db_, ResultsDb::Mode::kCreate);
+  const flocsim::orchestrator::Registered reg =
+      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = 3;
+  p.device = "cuda";
+  p.gpus = 2;
+  const flocsim::orchestrator::PoolSummary s = flocsim::orchestrator::run_pool(db, reg.sweep, p);
+  EXPECT_EQ(s.completed, 6);
+  std::map<double, std::string> gpu_of;
+  for (double x : {1, 2, 3, 4, 5, 6}) {
+    const std::string line = t::read_text(run_dir(x) / "devices.log");
+    EXPECT_EQ(line.rfind("device cuda gpu ", 0), 0u) << line;
+    gpu_of[x] = line.substr(16, line.size() - 17);
+    EXPECT_TRUE(gpu_of[x] == "0" || gpu_of[x] == "1") << line;  // only the two GPUs
+  }
+  // the first three start together, in grid order: one GPU each, then the
+  // least busy (the lower index among equals) takes the third
+  EXPECT_EQ(gpu_of[1], "0");
+  EXPECT_EQ(gpu_of[2], "1");
+  EXPECT_EQ(gpu_of[3], "0");
+}
+
+TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
+  const flocsim::orchestrator::SweepSpec spec =
+      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 10));
+  ResultsDb db(db_, ResultsDb::Mode::kCreate);
+  const flocsim::orchestrator::Registered reg =
+      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = 2;
+  ASSERT_EQ(flocsim::orchestrator::run_pool(db, reg.sweep, p).completed, 2);
+  for (double x : {1, 2}) {
+    const std::string line = t::read_text(run_dir(x) / "devices.log");
+    // the orchestrator's own CUDA_VISIBLE_DEVICES, if any, passes through untouched
+    const char* inherited = std::getenv("CUDA_VISIBLE_DEVICES");
+    EXPECT_EQ(line, std::string("device - gpu ") + (inherited ? inherited : "-") + "\n");
+  }
+}
+
+TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
+  // What a sweep launched on cuda hands sbatch, against a stand-in Slurm
+  // (squeue answers, sbatch writes down its arguments and gives a job id):
+  // each array task asks for one GPU unless the sweep names its gres, and its
+  // task file tells the task's pool --device cuda. Needs a build with the
+  // CUDA back-end (one without refuses --device cuda, tested in test_cli).
+  if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
+  const fs::path bin = dir_ / "fake-slurm";
+  fs::create_directories(bin);
+  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+  t::write_text(bin / "sbatch",
+                "#!/bin/sh\nfor a in \"$@\"; do echo \"$a\"; done > \"$(dirname \"$0\")/args\"\n"
+                "echo 4242\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  fs::permissions(bin / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  for (const std::string gres : {"", "gpu:h100:2"}) {
+    json sweep = json::parse(t::read_text(fs::path(FLOCSIM_SOURCE_DIR) / "sweeps/ci.json"));
+    sweep["name"] = gres.empty() ? "gpu-default" : "gpu-named";
+    if (!gres.empty()) sweep["slurm"]["gres"] = gres;
+    t::write_text(dir_ / "sweep.json", sweep.dump());
+    const t::Output o =
+        t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db", db_, "--backend",
+                        "slurm", "--no-wait", "--device", "cuda"}),
+               {path});
+    ASSERT_EQ(o.code, 0) << o.out;
+    std::vector<std::string> args;
+    std::istringstream lines(t::read_text(bin / "args"));
+    for (std::string line; std::getline(lines, line);) args.push_back(line);
+    ASSERT_FALSE(args.empty());
+    EXPECT_NE(std::find(args.begin(), args.end(), "--gres=" + (gres.empty() ? "gpu:1" : gres)),
+              args.end())
+        << t::read_text(bin / "args");
+    // the task files beside the job script carry the device to the tasks' pools
+    const fs::path job_dir = fs::path(args.back()).parent_path();
+    EXPECT_EQ(t::read_json(job_dir / "task_0.json").value("device", ""), "cuda");
+  }
+}
+
+}  // namespace
