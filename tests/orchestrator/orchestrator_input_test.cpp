@@ -25,13 +25,8 @@
 #include "orchestrator/sweep.hpp"
 #include "orchestrator_fixture.hpp"
 
-namespace fs = std::filesystem;
-using flocsim::db::ResultsDb;
-using flocsim::db::RunState;
-using nlohmann::json;
-namespace t = flocsim::test;
-
-using flocsim::test::orchestrator_fixture::Orchestrator;
+// the fixture and its names: Orchestrator, fs, json, t (flocsim::test), ResultsDb, RunState
+using namespace flocsim::test::orchestrator_fixture;
 
 namespace {
 

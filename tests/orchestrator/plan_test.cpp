@@ -144,6 +144,20 @@ TEST(SweepPlan, TimesTheRealStepAndWeighsTheLatticesStorage) {
   EXPECT_NEAR(*plan.wall_max_s, sum, 1e-9 * sum);
 }
 
+// The plan of `spec` with the GPU figures `bench` (as bench_coupling_gpu
+// --json writes them) read from a file in `dir`; nothing timed here.
+orc::SweepPlan plan_on_gpu(const orc::SweepSpec& spec, const nlohmann::json& bench,
+                           const std::string& dir, orc::GpuRates& rates) {
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/bench-coupling-gpu.json";
+  std::ofstream(file) << bench.dump(2);
+  rates = orc::read_gpu_rates({file});
+  orc::PlanOptions o;
+  o.measure_steps = 0;
+  o.gpu = &rates;
+  return orc::plan_sweep(spec, o);
+}
+
 // --gpu-rate: a GPU benchmark's figures (as bench_coupling_gpu and
 // bench_fluid_gpu write them) give each configuration's seconds per step by
 // the model of orchestrator/gpu_rates.hpp, worked here by hand: the paper's
@@ -152,7 +166,6 @@ TEST(SweepPlan, TimesTheRealStepAndWeighsTheLatticesStorage) {
 // 1.5 ms to the step for 1320 x 900 markers.
 TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
   const std::string dir = ::testing::TempDir() + "/plan-gpu-rate";
-  std::filesystem::create_directories(dir);
   const orc::SweepSpec spec = paper_grid("paper");
   const auto first = flocsim::cases::parse_case(orc::expand(spec).front().case_json);
   const flocsim::coupling::Scheme& scheme = first.spheres.numerics.coupling;
@@ -165,13 +178,8 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
                              {"coupling_ms", 1.5},
                              {"spheres", 1320},
                              {"markers_per_sphere", 900}}}}};
-  const std::string file = dir + "/bench-coupling-gpu.json";
-  std::ofstream(file) << bench.dump(2);
-  const orc::GpuRates rates = orc::read_gpu_rates({file});
-  orc::PlanOptions o;
-  o.measure_steps = 0;
-  o.gpu = &rates;
-  const orc::SweepPlan plan = orc::plan_sweep(spec, o);
+  orc::GpuRates rates;
+  const orc::SweepPlan plan = plan_on_gpu(spec, bench, dir, rates);
   double gpu_hours = 0;
   int checked = 0;
   for (const orc::PlannedRun& r : plan.runs) {
@@ -197,10 +205,8 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
   // A figure of another precision is no figure for this grid: the plan says
   // why and falls back to what it has here (no measurement: no rate).
   bench["results"][0]["precision"] = single ? "double" : "float";
-  std::ofstream(file) << bench.dump(2);
-  const orc::GpuRates other = orc::read_gpu_rates({file});
-  o.gpu = &other;
-  const orc::SweepPlan without = orc::plan_sweep(spec, o);
+  orc::GpuRates other;
+  const orc::SweepPlan without = plan_on_gpu(spec, bench, dir, other);
   EXPECT_FALSE(without.wall_min_s);
   std::ostringstream why;
   orc::write_plan(without, why, false);
@@ -217,7 +223,6 @@ TEST(SweepPlan, AGpuBenchmarkGivesTheRateOfWhatTheGpuRuns) {
 // a_g at a = 4 is 4.017; any a_g in (3.634, 4.134] gives edge 13.)
 TEST(SweepPlan, AGpuBenchmarkOfPartiallySaturatedCellsScalesWithTheCoveredCells) {
   const std::string dir = ::testing::TempDir() + "/plan-gpu-rate-psm";
-  std::filesystem::create_directories(dir);
   orc::SweepSpec spec = paper_grid("draft");
   spec.base["numerics"] = {{"coupling", "partially-saturated"}};
   spec.axes = {orc::Axis{"phi", {nlohmann::json(0.12)}}, orc::Axis{"Re_inf", {nlohmann::json(12)}},
@@ -236,13 +241,8 @@ TEST(SweepPlan, AGpuBenchmarkOfPartiallySaturatedCellsScalesWithTheCoveredCells)
                                    {"coupling_ms", 2.0},
                                    {"spheres", 1320},
                                    {"cube_cells_per_sphere", 4913}}}}};
-  const std::string file = dir + "/bench-coupling-gpu.json";
-  std::ofstream(file) << bench.dump(2);
-  const orc::GpuRates rates = orc::read_gpu_rates({file});
-  orc::PlanOptions o;
-  o.measure_steps = 0;
-  o.gpu = &rates;
-  const orc::SweepPlan plan = orc::plan_sweep(spec, o);
+  orc::GpuRates rates;
+  const orc::SweepPlan plan = plan_on_gpu(spec, bench, dir, rates);
   ASSERT_EQ(plan.runs.size(), 1u);
   const orc::PlannedRun& r = plan.runs.front();
   ASSERT_TRUE(r.refused.empty()) << r.refused;
