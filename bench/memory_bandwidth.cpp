@@ -126,4 +126,33 @@ std::vector<BandwidthFigure> measure_memory_bandwidth(int threads, std::size_t b
           {"update x19 streams", threads, 2 * stream_bytes / t_streams}};
 }
 
+double measure_read_bandwidth(int threads, std::size_t bytes, int repetitions) {
+  const std::size_t n = bytes / sizeof(double) / 64 * 64;
+  double* a = alloc(n);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::size_t i = 0; i < n; ++i) a[i] = 1.0 + 1e-9 * static_cast<double>(i % 7);
+  std::vector<double> seconds;
+  double keep = 0;
+  for (int r = 0; r <= repetitions; ++r) {  // the first is a warm-up
+    const auto t0 = std::chrono::steady_clock::now();
+    double sum = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : sum)
+    {
+      // eight independent partial sums: one accumulator would wait on each
+      // addition's latency (no reassociation without -ffast-math), not on memory
+      double lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < n; i += 8)
+        for (int k = 0; k < 8; ++k) lane[k] += a[i + k];
+      for (double l : lane) sum += l;
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    keep += sum;  // used, so the sum is not optimised away
+    if (r > 0) seconds.push_back(s);
+  }
+  std::free(a);
+  if (!(keep > 0)) return 0;
+  return static_cast<double>(n * sizeof(double)) / median(seconds);
+}
+
 }  // namespace flocsim::bench

@@ -21,6 +21,11 @@ struct BandwidthFigure {
 std::vector<BandwidthFigure> measure_memory_bandwidth(int threads, std::size_t bytes_per_array,
                                                       int repetitions);
 
+// A read-only stream (a sum over one array, `threads` threads): the traffic
+// shape of a reduction over the lattice, such as the liquid averages.
+// Median over `repetitions`, bytes read per second.
+double measure_read_bandwidth(int threads, std::size_t bytes, int repetitions);
+
 double median(std::vector<double> v);
 
 }  // namespace flocsim::bench

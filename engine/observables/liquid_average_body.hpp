@@ -29,27 +29,44 @@ struct LiquidSums {
   long liquid_cells = 0;
 };
 
-// One cell: its density rho and velocity (ux, uy, uz) = (sum c f + F_body/2)
-// / rho, i.e. without its per-cell force; `field` its per-cell force density
-// (zero without a field); body_x the body force's x component; `solid`
-// whether its centre lies inside a sphere. The physical velocity adds half
-// the cell's field force; the raw momentum takes half the body force off
-// rho u (the field's half is not in rho u to begin with).
+// What one cell gives the sums: from its density rho and velocity (ux, uy,
+// uz) = (sum c f + F_body/2) / rho, i.e. without its per-cell force, and its
+// per-cell force density `field` (zero without a field): the physical velocity
+// adds half the cell's field force; the raw momentum takes half the body force
+// off rho u (the field's half is not in rho u to begin with).
+struct LiquidCell {
+  double u = 0, v = 0, w = 0;  // the physical velocity
+  double speed2 = 0;           // u^2 + v^2 + w^2; not finite after a blow-up
+  double momentum_x = 0;       // rho ux - body_x / 2
+};
+FLOCSIM_KERNEL_BODY LiquidCell liquid_cell(double rho, double ux, double uy, double uz,
+                                           double field_x, double field_y, double field_z,
+                                           double body_x) {
+  LiquidCell c;
+  c.momentum_x = rho * ux - 0.5 * body_x;
+  c.u = ux + 0.5 * field_x / rho;
+  c.v = uy + 0.5 * field_y / rho;
+  c.w = uz + 0.5 * field_z / rho;
+  c.speed2 = c.u * c.u + c.v * c.v + c.w * c.w;
+  return c;
+}
+
+// One cell added to the sums (the GPU's threads, cell after cell); `solid`:
+// its centre lies inside a sphere. The CPU adds whole rows of liquid_cell
+// with vector reductions instead (liquid_averages.cpp): the same terms, summed
+// in another order.
 FLOCSIM_KERNEL_BODY void add_liquid_cell(LiquidSums& s, double rho, double ux, double uy, double uz,
                                          double field_x, double field_y, double field_z,
                                          double body_x, bool solid) {
-  s.momentum_x += rho * ux - 0.5 * body_x;
+  const LiquidCell c = liquid_cell(rho, ux, uy, uz, field_x, field_y, field_z, body_x);
+  s.momentum_x += c.momentum_x;
   s.mass += rho;
-  const double u = ux + 0.5 * field_x / rho;
-  const double v = uy + 0.5 * field_y / rho;
-  const double w = uz + 0.5 * field_z / rho;
   // not finite after a blow-up: NaN never wins a comparison, so the mass tells
-  const double speed2 = u * u + v * v + w * w;
-  if (speed2 > s.max_speed2) s.max_speed2 = speed2;
-  s.velocity_x_all_cells += u;
+  if (c.speed2 > s.max_speed2) s.max_speed2 = c.speed2;
+  s.velocity_x_all_cells += c.u;
   if (solid) return;
-  if (speed2 > s.max_liquid_speed2) s.max_liquid_speed2 = speed2;
-  s.velocity_x += u;
+  if (c.speed2 > s.max_liquid_speed2) s.max_liquid_speed2 = c.speed2;
+  s.velocity_x += c.u;
   ++s.liquid_cells;
 }
 
