@@ -34,10 +34,10 @@ int threads_along_x(int nx) {
 // keep to the 128 registers a thread that this allows (the double covered
 // step needs 126), rather than fail at launch on a row longer than 480 cells.
 template <class Real, bool kForceField, bool kCoverage>
-__global__ void __launch_bounds__(512) aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx,
-                               Real by, Real bz, const Real* __restrict__ Fx,
-                               const Real* __restrict__ Fy, const Real* __restrict__ Fz,
-                               DeviceCoverage<Real> cover) {
+__global__ void __launch_bounds__(512)
+    aa_step_kernel(AaSlots<Real> s, bool even, CollisionConstants<Real> k, Real bx, Real by,
+                   Real bz, const Real* __restrict__ Fx, const Real* __restrict__ Fy,
+                   const Real* __restrict__ Fz, DeviceCoverage<Real> cover) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   if (x >= s.nx) return;
   const int y = blockIdx.y, z = blockIdx.z;
