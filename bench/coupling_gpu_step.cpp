@@ -72,6 +72,13 @@ spheres::SphereSet suspension(lattice::Extent e, double a, double phi) {
   return s;
 }
 
+// The spheres' radius, and the input radius each coupling takes at it: the
+// paper method's a_g at a = 6 for the immersed boundary, a itself for
+// partially saturated cells (as bench_coupling takes them on the CPU).
+constexpr double kRadius = 6.0;
+constexpr double kImmersedBoundaryInputRadius = 5.612;
+constexpr double kPartiallySaturatedInputRadius = kRadius;
+
 // One coupled step on the GPU, in the time loop's order: the coupling's
 // forcing (the immersed boundary's sweeps, or the spheres' coverage), the
 // lattice step, and for partially saturated cells the exchange that gives
@@ -83,9 +90,11 @@ class CoupledGpuStep {
       : lattice_(lattice) {
     if (scheme.immersed_boundary())
       ib_ = std::make_unique<gpu::GpuImmersedBoundary<Real>>(
-          immersed_boundary::ImmersedBoundarySettings{.input_radius = 5.612, .scheme = scheme});
+          immersed_boundary::ImmersedBoundarySettings{.input_radius = kImmersedBoundaryInputRadius,
+                                                      .scheme = scheme});
     else
-      psm_ = std::make_unique<gpu::GpuPartiallySaturatedCells<Real>>(6.0, lattice);
+      psm_ = std::make_unique<gpu::GpuPartiallySaturatedCells<Real>>(kPartiallySaturatedInputRadius,
+                                                                     lattice);
   }
   void step(lattice::FluidLattice<Real>& mirror, const spheres::SphereSet& s) {
     if (ib_) ib_->apply(lattice_, s);  // waits for its loads: the step's real order
@@ -97,7 +106,7 @@ class CoupledGpuStep {
   // its markers, or the cells of the cube it covers.
   nlohmann::json work_per_sphere() const {
     if (ib_) return {{"markers_per_sphere", ib_->markers_per_sphere()}};
-    const int edge = partially_saturated::covering_box_edge(6.0);
+    const int edge = partially_saturated::covering_box_edge(kPartiallySaturatedInputRadius);
     return {{"cube_cells_per_sphere", edge * edge * edge}};
   }
 
@@ -220,7 +229,7 @@ int main(int argc, char** argv) {
   const lattice::Extent e{static_cast<int>(std::lround(288 / scale)),
                           static_cast<int>(std::lround(144 / scale)),
                           static_cast<int>(std::lround(144 / scale))};
-  const spheres::SphereSet s = suspension(e, 6.0, 0.2);
+  const spheres::SphereSet s = suspension(e, kRadius, 0.2);
   std::printf("GPU: %s; box %d x %d x %d, %zu spheres (phi 0.2, a = 6), %d reps of %d steps\n",
               q.devices[0].name.c_str(), e.nx, e.ny, e.nz, s.size(), reps, steps);
   std::printf("%-34s %-6s %12s %12s %8s %8s\n", "option", "prec", "fluid MLUPS", "full MLUPS",
