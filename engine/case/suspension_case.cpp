@@ -49,7 +49,9 @@ constexpr double kNearViscosityFactor = 2.0 * (1 + 1e-9);
 //   0.08. The a = 6 close-pair tables now reach 0.08, so 0.07 (Re_inf 6 on
 //   0.14, 1.75 away) would be covered too, but its accuracy at a = 6 has not
 //   been compared with 0.04 in a suspension yet.
-// - paper keeps 0.02, inside the paper's own range (0.01-0.03).
+// - paper keeps 0.02, inside the paper's own range (0.01-0.03), raised where
+//   nu would fall below the paper's method's floor (Re_inf above 18 at a = 6;
+//   check_multi_sweep_floor).
 // A scene without liquid has no Mach number to trade (below).
 struct Preset {
   double radius_cells, length_over_a, stage1_min, stage1_max, stage2_settle, statistics;
@@ -272,17 +274,17 @@ double schiller_naumann_drag_coefficient(double reynolds) {
 
 namespace {
 // The coupling's period-2 oscillation (docs/numerics.md, "Stability floor"):
-// moving spheres, more than one forcing sweep, a < 6 dx, nu below its floor.
+// a suspension (moving spheres with close neighbours: the runaway sphere sat
+// in an aggregate; one settling sphere ran clean at a = 6 down to nu 0.0083),
+// more than one forcing sweep, nu below its floor.
 bool multi_sweep_oscillates(const SuspensionCase& c) {
-  return modules_of(c.scene).liquid && modules_of(c.scene).spheres_move &&
+  return c.scene == Scene::suspension && modules_of(c.scene).liquid &&
          c.numerics.coupling.immersed_boundary() && c.numerics.coupling.sweeps > 1 &&
-         c.numerics.radius_cells < 6 &&
-         c.numerics.viscosity < kSmallestMultiSweepViscosityBelowA6 * (1 - 1e-9);
+         c.numerics.viscosity < kSmallestMultiSweepViscosity * (1 - 1e-9);
 }
 // The U_inf that puts this case's viscosity on that floor.
 double settling_velocity_at_multi_sweep_floor(const SuspensionCase& c) {
-  return kSmallestMultiSweepViscosityBelowA6 * c.physics.reynolds_inf /
-         (2 * c.numerics.radius_cells);
+  return kSmallestMultiSweepViscosity * c.physics.reynolds_inf / (2 * c.numerics.radius_cells);
 }
 }  // namespace
 
@@ -498,7 +500,7 @@ void read_scheme(InputReader& num, Reading& r) {
   if (!r.has_nu && !r.has_u && multi_sweep_oscillates(c)) {
     const double u = settling_velocity_at_multi_sweep_floor(c);
     if (u <= kMaxSettlingVelocity) {
-      c.numerics.viscosity = kSmallestMultiSweepViscosityBelowA6;
+      c.numerics.viscosity = kSmallestMultiSweepViscosity;
       c.derived.settling_velocity = u;
       c.numerics.coupling = choose_scheme(num, r);
     }
@@ -661,11 +663,14 @@ void apply_radius_calibration(Reading& r) {
 }
 
 // The coupling's period-2 oscillation (docs/numerics.md): with more than one
-// forcing sweep below a = 6 dx, moving spheres at nu = 0.01 (the a = 4 stand-in
-// of the standard box) developed it from t = 26 a/U_inf in all five runs
-// measured, with and without the well and with either close-pair model: three
-// blew up, two shook 11-42 % of the spheres every step to the end. nu = 0.0133
-// and 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01.
+// forcing sweep, moving spheres at nu = 0.01 (the a = 4 stand-in of the
+// standard box) developed it from t = 26 a/U_inf in all five runs measured,
+// with and without the well and with either close-pair model: three blew up,
+// two shook 11-42 % of the spheres every step to the end. nu = 0.0133 and
+// 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01. At a = 6
+// the same onset (nu 0.0067 stopped by the coupling monitor at phi 0.2 and
+// 0.32 after 170-177 a/U_inf, 0.01 at or over its limit at Re_inf 72, 0.0133
+// completed 600 a/U_inf at phi 0.32).
 void check_multi_sweep_floor(const Reading& r) {
   const SuspensionCase& c = r.c;
   if (!multi_sweep_oscillates(c)) return;
@@ -673,14 +678,34 @@ void check_multi_sweep_floor(const Reading& r) {
   const double u_needed = settling_velocity_at_multi_sweep_floor(c);
   if (r.has_nu)
     remedies.push_back("raise numerics.viscosity to at least " +
-                       format_value(kSmallestMultiSweepViscosityBelowA6));
+                       format_value(kSmallestMultiSweepViscosity));
   else if (u_needed <= kMaxSettlingVelocity)
     remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
   if (c.physics.phi <= coupling::largest_validated_phi(coupling::kOneSweepScheme))
     remedies.push_back(
         "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
         "\"sweeps\": 1})");
-  remedies.push_back("raise numerics.a_over_dx to 6");
+  // a finer lattice reaches the floor at a smaller U_inf (nu = 2 a U_inf / Re_inf):
+  // the smallest calibrated resolution where the Mach limit allows it (with a
+  // given U_inf, the U_inf it then needs; a given viscosity stays as it is)
+  const double a = c.numerics.radius_cells;
+  const auto reaches_floor = [&](double radius) {
+    return 2 * radius * kMaxSettlingVelocity >=
+           kSmallestMultiSweepViscosity * c.physics.reynolds_inf * (1 - 1e-9);
+  };
+  for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
+    if (!r.has_nu && calibrated > a && reaches_floor(calibrated)) {
+      const double u_there =
+          kSmallestMultiSweepViscosity * c.physics.reynolds_inf / (2 * calibrated);
+      remedies.push_back("raise numerics.a_over_dx to " + format_value(calibrated) +
+                         (r.has_u && c.derived.settling_velocity < u_there * (1 - 1e-9)
+                              ? " with numerics.U_inf at least " + format_value(u_there)
+                              : ""));
+      break;
+    }
+  if (!reaches_floor(a))
+    remedies.push_back("lower Re_inf to at most " +
+                       format_value(2 * a * kMaxSettlingVelocity / kSmallestMultiSweepViscosity));
   std::string ways;
   for (std::size_t k = 0; k < remedies.size(); ++k)
     ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];
@@ -690,7 +715,7 @@ void check_multi_sweep_floor(const Reading& r) {
       " immersed-boundary sweeps at a_over_dx = " + format_value(c.numerics.radius_cells) +
       ": the coupling of moving spheres is measured to oscillate there below "
       "viscosity " +
-      format_value(kSmallestMultiSweepViscosityBelowA6) + " (docs/numerics.md); " + ways);
+      format_value(kSmallestMultiSweepViscosity) + " (docs/numerics.md); " + ways);
 }
 
 // lubrication_model calibrated: the lattice's share from the shipped close-pair table.

@@ -34,11 +34,17 @@ inline constexpr double kMaxSettlingVelocity = 0.07;
 // check (0.3 per step) must stay far out in that distribution's tail: 6 U_inf
 // at 0.05 (at 0.07, 4.3 U_inf, a granular gas of 61 spheres reached it).
 inline constexpr double kMaxSettlingVelocityWithoutLiquid = 0.05;
-// Below a = 6 dx with more than one immersed-boundary sweep, the smallest
-// viscosity at which moving spheres were measured free of the coupling's
-// period-2 oscillation (docs/numerics.md): 0.0133 = U_inf 0.02 at a = 4 and
-// Re_inf 12 (clean for 80 a/U_inf, where nu = 0.01 oscillated from t = 26).
-inline constexpr double kSmallestMultiSweepViscosityBelowA6 = 0.04 / 3;
+// With more than one immersed-boundary sweep, the smallest viscosity at which
+// moving spheres were measured free of the coupling's period-2 oscillation
+// (docs/numerics.md): 0.0133 = U_inf 0.02 at a = 4 and Re_inf 12 (clean for
+// 80 a/U_inf, where nu = 0.01 oscillated from t = 26). At a = 6 the onset
+// sits at the same viscosity (16a x 8a x 8a boxes, phi 0.32 and 0.2, Re_inf
+// 36-72): nu 0.0067 stopped by the coupling monitor at both phi, 0.01 at or
+// over its limit at Re_inf 72; at 0.0133 a run of the paper's length (600
+// a/U_inf, phi 0.32, Re_inf 60) completed with its worst window at 0.72 of
+// the limit. So one floor at every resolution (at a = 8 and above assumed,
+// not measured); the monitor stops a run that crosses it all the same.
+inline constexpr double kSmallestMultiSweepViscosity = 0.04 / 3;
 // Largest lattice viscosity accepted in a scene with liquid, whether given
 // (numerics.viscosity) or implied by Re_inf and U_inf (nu = 2 a U_inf /
 // Re_inf): one rule, the viscosity ceiling (docs/numerics.md, "Viscosity

@@ -250,7 +250,8 @@ RunReport run_scene(const cases::SuspensionCase& c, const RunOptions& o) {
                           what,
                           "U_inf too high for the Mach limit, a viscosity too small for the "
                           "resolution, a density ratio near 1, or the coupling's period-2 "
-                          "oscillation (measured with the paper's IB method at a = 4, nu = 0.01; "
+                          "oscillation (measured with the paper's IB method at nu = 0.01 at a = 4, "
+                          "0.0067-0.01 at a = 6; "
                           "docs/numerics.md: a larger viscosity or the one-sweep option runs)");
   };
 

@@ -122,13 +122,15 @@ TEST(SuspensionCase, LiquidBodyForceBalancesNetGravityOnSpheres) {
 }
 
 TEST(SuspensionCase, DefaultViscosityStaysInTheTestedRange) {
-  // The paper preset at Re_inf = 72: its U_inf = 0.02 would need nu = 0.0033
-  // < 0.005, so the default keeps nu = 0.005 and raises U_inf to 72 * 0.005 /
-  // 12 = 0.03.
+  // The standard preset at Re_inf = 120 (phi 0.2: one sweep, so the paper's
+  // method's higher floor does not apply): its U_inf = 0.04 would need nu =
+  // 2 * 6 * 0.04 / 120 = 0.004 < 0.005, so the default keeps nu = 0.005 and
+  // raises U_inf to 120 * 0.005 / 12 = 0.05.
   const SuspensionCase c = parse_suspension_case(
-      {{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.2}, {"Re_inf", 72}});
+      {{"scene", "suspension"}, {"fidelity", "standard"}, {"phi", 0.2}, {"Re_inf", 120}});
+  EXPECT_EQ(c.numerics.coupling.sweeps, 1);
   EXPECT_DOUBLE_EQ(c.numerics.viscosity, 0.005);
-  EXPECT_NEAR(c.derived.settling_velocity, 0.03, 1e-15);
+  EXPECT_NEAR(c.derived.settling_velocity, 0.05, 1e-15);
   for (const auto& w : c.warnings) EXPECT_EQ(w.find("smallest tested"), std::string::npos) << w;
 }
 
@@ -337,10 +339,10 @@ TEST(SuspensionCase, PresetsTakeTheOneSweepOptionOnlyWhereValidated) {
                                     HasSubstr("phi = 0.25"), HasSubstr("up to phi = 0.2")));
 }
 
-// Moving spheres with the multi-sweep coupling below a = 6 dx are measured to
-// oscillate at nu = 0.01 (docs/numerics.md): such a case is refused before any
-// work, naming what runs; the one-sweep option, nu = 0.0133 and spheres held
-// still are not.
+// Moving spheres with the multi-sweep coupling are measured to oscillate at
+// nu = 0.01 at a = 4 and at nu = 0.0067-0.01 at a = 6 (docs/numerics.md): such
+// a case is refused before any work, naming what runs; the one-sweep option,
+// nu = 0.0133 and spheres held still are not.
 TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
   const json paper_ib = {{"marker_spacing", 0.7}, {"sweeps", 2}};
   const json unstable = {{"scene", "suspension"},
@@ -384,6 +386,40 @@ TEST(SuspensionCase, MultiSweepCouplingBelowItsViscosityFloorIsRefused) {
   dense["phi"] = 0.25;
   EXPECT_THAT(refusal(dense), AllOf(HasSubstr("below viscosity 0.0133333"),
                                     ::testing::Not(HasSubstr("one-sweep"))));
+}
+
+// The same floor at a = 6 (the paper preset takes the paper's method at every
+// phi). By hand: U_inf on the floor = Re_inf * 0.0133 / 12. At Re_inf 48 that
+// is 0.0533 <= 0.07: the preset's 0.02 is raised to it. At Re_inf 72 it is
+// 0.08, past the Mach limit: refused, naming a = 8 (2 * 8 * 0.07 / 0.0133 =
+// 84 >= 72) and the largest Re_inf a = 6 reaches, 2 * 6 * 0.07 / 0.0133 = 63.
+TEST(SuspensionCase, MultiSweepFloorHoldsAtASixToo) {
+  const json re48 = {{"scene", "suspension"}, {"fidelity", "paper"}, {"phi", 0.32}, {"Re_inf", 48}};
+  const SuspensionCase raised = parse_suspension_case(re48);
+  EXPECT_EQ(raised.numerics.coupling.sweeps, 2);
+  EXPECT_NEAR(raised.numerics.viscosity, 0.04 / 3, 1e-15);
+  EXPECT_NEAR(raised.derived.settling_velocity, 48 * 0.04 / 3 / 12, 1e-15);
+  json re72 = re48;
+  re72["Re_inf"] = 72;
+  EXPECT_THAT(
+      refusal(re72),
+      AllOf(HasSubstr("2 immersed-boundary sweeps at a_over_dx = 6"),
+            HasSubstr("below viscosity 0.0133333"), HasSubstr("a_over_dx to 8"),
+            HasSubstr("lower Re_inf to at most 63"), ::testing::Not(HasSubstr("U_inf to at least")),
+            ::testing::Not(HasSubstr("one-sweep"))));
+  // with U_inf given (the standard preset's 0.04), a = 8 needs U_inf 0.06 too
+  json given_u = re72;
+  given_u["numerics"] = {{"U_inf", 0.04}};
+  EXPECT_THAT(refusal(given_u), HasSubstr("a_over_dx to 8 with numerics.U_inf at least 0.06"));
+  // at phi 0.2 the one-sweep option is validated and named
+  json dilute = re72;
+  dilute["phi"] = 0.2;
+  EXPECT_THAT(refusal(dilute), HasSubstr("one-sweep option"));
+  // a = 8 reaches it: U_inf raised to 72 * 0.0133 / 16 = 0.06
+  json finer = re72;
+  finer["numerics"] = {{"a_over_dx", 8}};
+  const SuspensionCase at8 = parse_suspension_case(finer);
+  EXPECT_NEAR(at8.derived.settling_velocity, 72 * 0.04 / 3 / 16, 1e-15);
 }
 
 // Lubrication is the calibrated close-pair model unless the case names
@@ -793,7 +829,7 @@ TEST(SuspensionCaseCoupling, ControlForcingAndPartiallySaturatedCellsFromTheTabl
   EXPECT_FALSE(psm.to_json()["numerics"].contains("immersed_boundary"));
 }
 
-// The multi-sweep coupling's oscillation floor (a < 6, nu < 0.0133) is the
+// The multi-sweep coupling's oscillation floor (nu < 0.0133) is the
 // immersed boundary's: partially saturated cells have no sweeps, and a case
 // at a viscosity their table holds (0.01 at a = 4) is accepted as given.
 // Above phi = 0.2, where they were not checked, they are refused naming

@@ -3,12 +3,15 @@
 // version, each resolves to the case its result.json recorded (the same test a
 // resume applies), so a changed default (an IB scheme a preset now picks, a
 // lubrication model) cannot silently detach a committed case from its data.
+// A case that a later floor refuses (the runs that measured it) carries a
+// refused.txt whose first line the refusal must contain.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "engine/case/suspension_case.hpp"
+#include "engine/input/input_reader.hpp"
 #include "engine/run/output_directory.hpp"
 
 namespace flocsim {
@@ -32,6 +35,23 @@ TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
     const fs::path result = entry.path().parent_path() / "result.json";
     if (!fs::exists(result)) continue;
     SCOPED_TRACE(fs::relative(entry.path(), root).string());
+    // A run that measured where flocsim now refuses to go (the study that set
+    // a floor) keeps its record; refused.txt names the refusal it now meets.
+    if (const fs::path refused = entry.path().parent_path() / "refused.txt";
+        fs::exists(refused)) {
+      std::ifstream in(refused);
+      std::string expected;
+      std::getline(in, expected);
+      ASSERT_FALSE(expected.empty());
+      try {
+        cases::parse_suspension_case(read_json(entry.path()));
+        ADD_FAILURE() << "accepted, but refused.txt says it is refused: " << expected;
+      } catch (const input::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      }
+      ++checked;
+      continue;
+    }
     nlohmann::json ran = read_json(result).at("case");
     nlohmann::json now = cases::parse_suspension_case(read_json(entry.path())).to_json();
     // where the snapshot was read from is provenance, not physics
