@@ -217,13 +217,14 @@ void add_numerics_fields(std::vector<FieldSpec>& t) {
                          .at_most = kMaxSettlingVelocity,
                          .why = "(Mach limit for settling flows)"},
                .default_rule = kPreset +
-                               "0.07, 0.04, 0.02; granular 0.02), moved to the stability floor "
-                               "or the viscosity ceiling where nu would leave them",
+                               "0.07, 0.04, 0.02; granular 0.02), moved to the stability floor, "
+                               "the multi-sweep floor or the viscosity ceiling where nu would "
+                               "leave them",
                .unit = "lattice units",
                .contexts = kSpheres,
                .doc = "single-sphere settling velocity; not with viscosity",
-               .rules = "the Mach cap (granular: 0.05); the stability floor; the viscosity "
-                        "ceiling"});
+               .rules = "the Mach cap (granular: 0.05); the stability floor; the multi-sweep "
+                        "floor; the viscosity ceiling"});
   t.push_back({.path = "numerics.trt_magic",
                .type = FieldType::number,
                .range = {.above = 0, .at_most = 10},

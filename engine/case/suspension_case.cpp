@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -547,20 +548,33 @@ std::string beyond_reach(const SuspensionCase& c) {
   const double a = c.numerics.radius_cells;
   const double nu_min = smallest_stable_viscosity(a);
   const double largest_re = 2 * a * kMaxSettlingVelocity / nu_min;
+  // a suspension with more than one sweep needs its own, higher floor there too
+  const bool multi_sweep = c.scene == Scene::suspension &&
+                           c.numerics.coupling.immersed_boundary() &&
+                           c.numerics.coupling.sweeps > 1;
+  const auto floor_at = [&](double radius) {
+    return multi_sweep ? std::max(smallest_stable_viscosity(radius), kSmallestMultiSweepViscosity)
+                       : smallest_stable_viscosity(radius);
+  };
   double needed = 24;                              // the largest a_over_dx accepted
   for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
     if (calibrated > a &&
-        2 * calibrated * kMaxSettlingVelocity / smallest_stable_viscosity(calibrated) >=
-            c.physics.reynolds_inf) {
+        2 * calibrated * kMaxSettlingVelocity >= floor_at(calibrated) * c.physics.reynolds_inf) {
       needed = calibrated;
       break;
     }
+  // the standard preset runs such a case at a = 6 with one sweep (phi <= 0.2);
+  // the paper preset takes the paper's method, held to the higher floor
   return "at a_over_dx = " + format_value(a) +
          " the stability floor nu >= " + format_value(nu_min) +
          " and the Mach limit U_inf <= " + format_value(kMaxSettlingVelocity) +
          " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) +
          "; raise numerics.a_over_dx to at least " + format_value(needed) +
-         (a < 6 && needed <= 6 ? " (fidelity standard or paper)" : "") + " or lower Re_inf";
+         (a < 6 && needed <= 6 && !multi_sweep ? " (fidelity standard)" : "") +
+         (multi_sweep ? " (with " + std::to_string(c.numerics.coupling.sweeps) + " sweeps nu >= " +
+                            format_value(kSmallestMultiSweepViscosity) + " there)"
+                      : "") +
+         " or lower Re_inf";
 }
 
 // The Mach cap, for U_inf given, derived from a given viscosity or the preset's.
@@ -675,37 +689,49 @@ void check_multi_sweep_floor(const Reading& r) {
   const SuspensionCase& c = r.c;
   if (!multi_sweep_oscillates(c)) return;
   std::vector<std::string> remedies;
+  const double a = c.numerics.radius_cells, re = c.physics.reynolds_inf;
+  const double nu_floor = kSmallestMultiSweepViscosity;
   const double u_needed = settling_velocity_at_multi_sweep_floor(c);
-  if (r.has_nu)
-    remedies.push_back("raise numerics.viscosity to at least " +
-                       format_value(kSmallestMultiSweepViscosity));
-  else if (u_needed <= kMaxSettlingVelocity)
+  // nu = 2 a U_inf / Re_inf reaches the floor within the Mach limit at this a,
+  // or at the smallest finer resolution with close-pair calibrations (4, 6, 8)
+  const auto reaches_floor = [&](double radius) {
+    return 2 * radius * kMaxSettlingVelocity >= nu_floor * re * (1 - 1e-9);
+  };
+  double finer = 0;
+  for (double calibrated : {4.0, 6.0, 8.0})
+    if (calibrated > a && reaches_floor(calibrated)) {
+      finer = calibrated;
+      break;
+    }
+  if (r.has_nu) {
+    if (reaches_floor(a))
+      remedies.push_back("raise numerics.viscosity to at least " + format_value(nu_floor));
+    else if (finer > 0)
+      remedies.push_back("raise numerics.viscosity to at least " + format_value(nu_floor) +
+                         " with numerics.a_over_dx at least " + format_value(finer) +
+                         " (the Mach limit)");
+  } else if (u_needed <= kMaxSettlingVelocity) {
     remedies.push_back("raise numerics.U_inf to at least " + format_value(u_needed));
+  }
   if (c.physics.phi <= coupling::largest_validated_phi(coupling::kOneSweepScheme))
     remedies.push_back(
         "take the one-sweep option (numerics.immersed_boundary: {\"marker_spacing\": 1, "
         "\"sweeps\": 1})");
-  // a finer lattice reaches the floor at a smaller U_inf (nu = 2 a U_inf / Re_inf):
-  // the smallest calibrated resolution where the Mach limit allows it (with a
-  // given U_inf, the U_inf it then needs; a given viscosity stays as it is)
-  const double a = c.numerics.radius_cells;
-  const auto reaches_floor = [&](double radius) {
-    return 2 * radius * kMaxSettlingVelocity >=
-           kSmallestMultiSweepViscosity * c.physics.reynolds_inf * (1 - 1e-9);
-  };
-  for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
-    if (!r.has_nu && calibrated > a && reaches_floor(calibrated)) {
-      const double u_there =
-          kSmallestMultiSweepViscosity * c.physics.reynolds_inf / (2 * calibrated);
-      remedies.push_back("raise numerics.a_over_dx to " + format_value(calibrated) +
-                         (r.has_u && c.derived.settling_velocity < u_there * (1 - 1e-9)
-                              ? " with numerics.U_inf at least " + format_value(u_there)
-                              : ""));
-      break;
-    }
-  if (!reaches_floor(a))
-    remedies.push_back("lower Re_inf to at most " +
-                       format_value(2 * a * kMaxSettlingVelocity / kSmallestMultiSweepViscosity));
+  if (!r.has_nu && finer > 0) {
+    // a finer lattice reaches the floor at a smaller U_inf; with a given U_inf,
+    // the U_inf it then needs
+    const double u_there = nu_floor * re / (2 * finer);
+    remedies.push_back("raise numerics.a_over_dx to " + format_value(finer) +
+                       (r.has_u && c.derived.settling_velocity < u_there * (1 - 1e-9)
+                            ? " with numerics.U_inf at least " + format_value(u_there)
+                            : ""));
+  }
+  if (!r.has_nu) {
+    // at this a and the given U_inf (else the Mach limit), nu reaches the
+    // floor up to this Re_inf
+    const double u_top = r.has_u ? c.derived.settling_velocity : kMaxSettlingVelocity;
+    remedies.push_back("lower Re_inf to at most " + format_value(2 * a * u_top / nu_floor));
+  }
   std::string ways;
   for (std::size_t k = 0; k < remedies.size(); ++k)
     ways += (k == 0 ? "" : k + 1 == remedies.size() ? " or " : ", ") + remedies[k];

@@ -410,7 +410,17 @@ TEST(SuspensionCase, MultiSweepFloorHoldsAtASixToo) {
   // with U_inf given (the standard preset's 0.04), a = 8 needs U_inf 0.06 too
   json given_u = re72;
   given_u["numerics"] = {{"U_inf", 0.04}};
-  EXPECT_THAT(refusal(given_u), HasSubstr("a_over_dx to 8 with numerics.U_inf at least 0.06"));
+  // and at its U_inf, a = 6 reaches the floor up to Re_inf 2 * 6 * 0.04 / 0.0133 = 36
+  EXPECT_THAT(refusal(given_u), AllOf(HasSubstr("a_over_dx to 8 with numerics.U_inf at least 0.06"),
+                                      HasSubstr("lower Re_inf to at most 36")));
+  // with the viscosity given (nu 0.01), 0.0133 at Re_inf 72 needs U_inf 0.08 at
+  // a = 6, past the Mach limit: the viscosity with a = 8; Re_inf cannot help
+  json given_nu = re72;
+  given_nu["numerics"] = {{"viscosity", 0.01}};
+  EXPECT_THAT(refusal(given_nu),
+              AllOf(HasSubstr("raise numerics.viscosity to at least 0.0133333 with "
+                              "numerics.a_over_dx at least 8"),
+                    ::testing::Not(HasSubstr("lower Re_inf"))));
   // at phi 0.2 the one-sweep option is validated and named
   json dilute = re72;
   dilute["phi"] = 0.2;

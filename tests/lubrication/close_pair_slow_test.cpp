@@ -17,7 +17,7 @@ TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4PaperViscosity) {
 }
 
 // nu = 0.014: between the 0.01 and 0.02 entries, just above the viscosity
-// below which a case with the paper's two-sweep method at a < 6 is refused
+// below which a suspension with the paper's two-sweep method is refused
 // (its coupling oscillates there; docs/numerics.md).
 TEST(ClosePairSlow, TotalResistanceNearBrennerAtA4LowViscosity) {
   expect_total_near_brenner(4, 0.014, kGaps);

@@ -220,8 +220,9 @@ TEST(LiquidScenes, OtherCouplingsStopAndResumeBitIdentically) {
 // up to 0.03), densest and most inertial with the strongest well, and dilute
 // and slow: the paper's method (which the presets take at phi > 0.2) on its
 // floor at a = 6 (nu = 0.0133 with U_inf at the Mach limit 0.07: Re_inf 63,
-// the largest it reaches there; Re_inf 72 is refused, docs/numerics.md) and
-// the draft preset's numerics at Re_inf 6 stay stable, spheres never overlap
+// the largest it reaches there; Re_inf 72 is refused, docs/numerics.md), the
+// one-sweep option at phi 0.2 and Re_inf 72 on the lattice's floor (nu =
+// 0.005, tau 0.515) and the draft preset's numerics at Re_inf 6 stay stable, spheres never overlap
 // beyond the event engine's tolerance, and the momentum of liquid + spheres
 // does not drift. A short run in the smallest box the case accepts, started
 // from a random, non-overlapping placement, at a = 4, or at a = 6 where the
@@ -231,7 +232,8 @@ TEST(LiquidScenes, CornersOfTheParameterSpaceStayStable) {
   struct Corner {
     double phi, re_inf, du, a;
   };
-  for (const Corner k : {Corner{0.32, 63, 0.03, 6}, Corner{0.12, 6, 0.03, 4}}) {
+  for (const Corner k :
+       {Corner{0.32, 63, 0.03, 6}, Corner{0.2, 72, 0.03, 6}, Corner{0.12, 6, 0.03, 4}}) {
     json j = json::parse(R"({
       "scene": "suspension", "fidelity": "draft", "L_over_a": 14, "precision": "float",
       "protocol": {"stage1_min": 1, "stage1_max": 1, "stage2_settle": 0.5, "statistics": 2,
@@ -241,8 +243,11 @@ TEST(LiquidScenes, CornersOfTheParameterSpaceStayStable) {
     j["Re_inf"] = k.re_inf;
     j["du_over_Uinf"] = k.du;
     j["numerics"]["a_over_dx"] = k.a;
-    // the floor itself: the draft preset's U_inf (0.07) would give nu = 0.0133 too
+    // the floors themselves: the paper's method's (the draft preset's U_inf 0.07
+    // would give nu = 0.0133 too), and at phi 0.2, where the preset takes one
+    // sweep, the lattice's, nu = 0.005 (tau 0.515)
     if (k.re_inf == 63) j["numerics"]["viscosity"] = cases::kSmallestMultiSweepViscosity;
+    if (k.re_inf == 72) j["numerics"]["viscosity"] = cases::smallest_stable_viscosity(6);
     const cases::SuspensionCase c = cases::parse_suspension_case(j);
     const fs::path dir = fresh_dir("corner");
     const RunReport r = run_sphere_case(c, {dir, false, true, 0});

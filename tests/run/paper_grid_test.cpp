@@ -73,7 +73,8 @@ TEST(PaperGrid, EveryPointParsesOrIsRefusedWithWhatWouldWork) {
         else
           EXPECT_THAT(std::string(e.what()),
                       AllOf(HasSubstr("Re_inf <= 2 a U_inf / nu = 56"),
-                            HasSubstr("raise numerics.a_over_dx to at least 6")))
+                            HasSubstr(two_sweeps ? "raise numerics.a_over_dx to at least 8"
+                                                 : "raise numerics.a_over_dx to at least 6")))
               << fidelity << " " << p.point.dump();
       }
     }

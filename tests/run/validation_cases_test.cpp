@@ -4,7 +4,7 @@
 // resume applies), so a changed default (an IB scheme a preset now picks, a
 // lubrication model) cannot silently detach a committed case from its data.
 // A case that a later floor refuses (the runs that measured it) carries a
-// refused.txt whose first line the refusal must contain.
+// now-refused.txt whose first line the refusal must contain.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -36,8 +36,8 @@ TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
     if (!fs::exists(result)) continue;
     SCOPED_TRACE(fs::relative(entry.path(), root).string());
     // A run that measured where flocsim now refuses to go (the study that set
-    // a floor) keeps its record; refused.txt names the refusal it now meets.
-    if (const fs::path refused = entry.path().parent_path() / "refused.txt";
+    // a floor) keeps its record; now-refused.txt names the refusal it now meets.
+    if (const fs::path refused = entry.path().parent_path() / "now-refused.txt";
         fs::exists(refused)) {
       std::ifstream in(refused);
       std::string expected;
@@ -45,7 +45,7 @@ TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
       ASSERT_FALSE(expected.empty());
       try {
         cases::parse_suspension_case(read_json(entry.path()));
-        ADD_FAILURE() << "accepted, but refused.txt says it is refused: " << expected;
+        ADD_FAILURE() << "accepted, but now-refused.txt says it is refused: " << expected;
       } catch (const input::InputError& e) {
         EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
       }
