@@ -14,39 +14,56 @@ namespace flocsim::cases {
 using input::InputError;
 
 namespace {
+// A suspension coupled by the immersed boundary with more than one sweep: the
+// cases the multi-sweep floor holds (a single settling sphere ran clean at
+// a = 6 down to nu 0.0083; its oscillation needs neighbours).
+bool multi_sweep_suspension(const SuspensionCase& c) {
+  return c.scene == Scene::suspension && c.numerics.coupling.immersed_boundary() &&
+         c.numerics.coupling.sweeps > 1;
+}
+
+// The smallest viscosity this case may run at with a_over_dx = radius.
+double viscosity_floor(const SuspensionCase& c, double radius) {
+  const double lattice = smallest_stable_viscosity(radius);
+  return multi_sweep_suspension(c) ? std::max(lattice, kSmallestMultiSweepViscosity) : lattice;
+}
+
+// The smallest resolution with shipped calibrations (radius and close pairs
+// for both immersed-boundary options) above this case's a at which nu = 2 a
+// U_inf / Re_inf reaches the floor within the Mach limit; 0 where none does.
+double finer_resolution_reaching_floor(const SuspensionCase& c) {
+  for (double calibrated : {4.0, 6.0, 8.0})
+    if (calibrated > c.numerics.radius_cells &&
+        2 * calibrated * kMaxSettlingVelocity >=
+            viscosity_floor(c, calibrated) * c.physics.reynolds_inf * (1 - 1e-9))
+      return calibrated;
+  return 0;
+}
+
 // Re_inf = 2 a U_inf / nu: with U_inf at the Mach limit and nu at the
 // stability floor the largest Re_inf grows with a. Where this Re_inf is out of
-// reach at this a, say so and name the smallest a that reaches it.
+// reach at this a, say so and name the smallest a that reaches it (the paper's
+// method held to its own floor there: the standard preset runs such a case at
+// a = 6 with one sweep, phi <= 0.2).
 std::string beyond_reach(const SuspensionCase& c) {
   const double a = c.numerics.radius_cells;
   const double nu_min = smallest_stable_viscosity(a);
   const double largest_re = 2 * a * kMaxSettlingVelocity / nu_min;
-  // a suspension with more than one sweep needs its own, higher floor there too
-  const bool multi_sweep = c.scene == Scene::suspension &&
-                           c.numerics.coupling.immersed_boundary() &&
-                           c.numerics.coupling.sweeps > 1;
-  const auto floor_at = [&](double radius) {
-    return multi_sweep ? std::max(smallest_stable_viscosity(radius), kSmallestMultiSweepViscosity)
-                       : smallest_stable_viscosity(radius);
-  };
-  double needed = 24;                              // the largest a_over_dx accepted
-  for (double calibrated : {4.0, 6.0, 8.0, 12.0})  // the shipped calibration's resolutions
-    if (calibrated > a &&
-        2 * calibrated * kMaxSettlingVelocity >= floor_at(calibrated) * c.physics.reynolds_inf) {
-      needed = calibrated;
-      break;
-    }
-  // the standard preset runs such a case at a = 6 with one sweep (phi <= 0.2);
-  // the paper preset takes the paper's method, held to the higher floor
+  const bool multi_sweep = multi_sweep_suspension(c);
+  const double needed = finer_resolution_reaching_floor(c);
+  const std::string finer =
+      needed > 0
+          ? "raise numerics.a_over_dx to at least " + format_value(needed) +
+                (a < 6 && needed <= 6 && !multi_sweep ? " (fidelity standard)" : "") +
+                (multi_sweep
+                     ? " (with " + std::to_string(c.numerics.coupling.sweeps) +
+                           " sweeps nu >= " + format_value(kSmallestMultiSweepViscosity) + " there)"
+                     : "")
+          : "no calibrated a_over_dx (4, 6, 8) reaches it";
   return "at a_over_dx = " + format_value(a) +
          " the stability floor nu >= " + format_value(nu_min) +
          " and the Mach limit U_inf <= " + format_value(kMaxSettlingVelocity) +
-         " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) +
-         "; raise numerics.a_over_dx to at least " + format_value(needed) +
-         (a < 6 && needed <= 6 && !multi_sweep ? " (fidelity standard)" : "") +
-         (multi_sweep ? " (with " + std::to_string(c.numerics.coupling.sweeps) + " sweeps nu >= " +
-                            format_value(kSmallestMultiSweepViscosity) + " there)"
-                      : "") +
+         " allow Re_inf <= 2 a U_inf / nu = " + format_value(largest_re) + "; " + finer +
          " or lower Re_inf";
 }
 }  // namespace
@@ -56,12 +73,9 @@ double smallest_stable_viscosity(double radius_cells) {
 }
 
 // The coupling's period-2 oscillation (docs/numerics.md, "Stability floor"):
-// a suspension (moving spheres with close neighbours: the runaway sphere sat
-// in an aggregate; one settling sphere ran clean at a = 6 down to nu 0.0083),
-// more than one forcing sweep, nu below its floor.
+// a multi-sweep suspension below its floor.
 bool multi_sweep_oscillates(const SuspensionCase& c) {
-  return c.scene == Scene::suspension && modules_of(c.scene).liquid &&
-         c.numerics.coupling.immersed_boundary() && c.numerics.coupling.sweeps > 1 &&
+  return multi_sweep_suspension(c) &&
          c.numerics.viscosity < kSmallestMultiSweepViscosity * (1 - 1e-9);
 }
 // The U_inf that puts this case's viscosity on that floor.
@@ -162,19 +176,12 @@ void check_multi_sweep_floor(const SuspensionCase& c, bool viscosity_given,
   const double a = c.numerics.radius_cells, re = c.physics.reynolds_inf;
   const double nu_floor = kSmallestMultiSweepViscosity;
   const double u_needed = settling_velocity_at_multi_sweep_floor(c);
-  // nu = 2 a U_inf / Re_inf reaches the floor within the Mach limit at this a,
-  // or at the smallest finer resolution with close-pair calibrations (4, 6, 8)
-  const auto reaches_floor = [&](double radius) {
-    return 2 * radius * kMaxSettlingVelocity >= nu_floor * re * (1 - 1e-9);
-  };
-  double finer = 0;
-  for (double calibrated : {4.0, 6.0, 8.0})
-    if (calibrated > a && reaches_floor(calibrated)) {
-      finer = calibrated;
-      break;
-    }
+  // nu = 2 a U_inf / Re_inf reaches the floor within the Mach limit at this
+  // a, or at the smallest finer calibrated one
+  const bool reaches_floor_here = 2 * a * kMaxSettlingVelocity >= nu_floor * re * (1 - 1e-9);
+  const double finer = finer_resolution_reaching_floor(c);
   if (viscosity_given) {
-    if (reaches_floor(a))
+    if (reaches_floor_here)
       remedies.push_back("raise numerics.viscosity to at least " + format_value(nu_floor));
     else if (finer > 0)
       remedies.push_back("raise numerics.viscosity to at least " + format_value(nu_floor) +
