@@ -1,3 +1,9 @@
+// The case-file field table (case_fields.hpp says what reads it): one row per
+// field, each group of fields one function, in the order the readers read
+// them (sphere scenes: identity, physics, lubrication and box, numerics,
+// coupling, input radius, protocol; the fluid scene: its lattice, initial flow
+// and run), assembled by make_table(); then the lookups, the typed readers and
+// the generated Markdown tables and JSON Schema.
 #include "engine/case/case_fields.hpp"
 
 #include <stdexcept>

@@ -1,3 +1,12 @@
+// Reads a sphere scene's case file into a SuspensionCase, once, in this order
+// (parse_suspension_case, near the end): the fields checked against their
+// table (case_fields.hpp); identity and the fidelity preset (preset(), with
+// why each preset's values); physics; the velocity scale and the coupling
+// scheme, moved onto the numerical limits where the case leaves them to it
+// (numerics_limits.hpp); the calibrated marker radius and close pairs; the
+// protocol; then the derived box, sphere count and forces, and the checks that
+// refuse what cannot run. The canonical form (to_json) and older versions'
+// models close the file.
 #include "engine/case/suspension_case.hpp"
 
 #include <unistd.h>
