@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "engine/case/resolved_case.hpp"
@@ -228,6 +229,29 @@ int least_busy_gpu(const std::vector<Worker>& running, int gpus) {
   return static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
 }
 
+}  // namespace
+
+std::vector<std::string> visible_gpu_ids(const char* inherited,
+                                         const std::vector<int>& cuda_indices) {
+  std::vector<std::string> list;
+  if (inherited) {
+    std::stringstream in(inherited);
+    for (std::string item; std::getline(in, item, ',');) {
+      const auto first = item.find_first_not_of(" \t");
+      const auto last = item.find_last_not_of(" \t");
+      list.push_back(first == std::string::npos ? "" : item.substr(first, last - first + 1));
+    }
+  }
+  std::vector<std::string> ids;
+  for (int i : cuda_indices) {
+    const auto at = static_cast<std::size_t>(i);
+    ids.push_back(i >= 0 && at < list.size() && !list[at].empty() ? list[at] : std::to_string(i));
+  }
+  return ids;
+}
+
+namespace {
+
 void write_case_file(const std::string& run_dir, const std::string& case_json) {
   const fs::path dir(run_dir);
   const fs::path tmp = dir / "case.json.tmp";
@@ -348,7 +372,9 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
         }
         if (o.device == "cuda" && o.gpus > 1) {
           w.gpu = least_busy_gpu(workers, o.gpus);
-          env.emplace_back("CUDA_VISIBLE_DEVICES", std::to_string(w.gpu));
+          const auto slot = static_cast<std::size_t>(w.gpu);
+          env.emplace_back("CUDA_VISIBLE_DEVICES",
+                           slot < o.gpu_ids.size() ? o.gpu_ids[slot] : std::to_string(w.gpu));
         }
         w.pid = spawn(argv, run.run_dir + "/worker.log", env);
         w.pid_start = process_start_time(w.pid);

@@ -42,8 +42,19 @@ struct PoolOptions {
   // runs the fewest workers (CUDA_VISIBLE_DEVICES), so jobs > gpus shares them.
   std::string device;
   int gpus = 1;
+  // The CUDA_VISIBLE_DEVICES value that names each of the `gpus` GPUs
+  // (visible_gpu_ids); empty: their CUDA indices 0 .. gpus - 1.
+  std::vector<std::string> gpu_ids;
   std::ostream* out = nullptr;  // progress lines; nothing when null
 };
+
+// What a worker's CUDA_VISIBLE_DEVICES must say to give it the GPU that this
+// process sees at CUDA index i, for each i of `cuda_indices`: where this
+// process was itself given a list (`inherited`, e.g. "2,3" or GPU UUIDs),
+// index i is that list's i-th entry, not the machine's GPU i; without one,
+// the index itself.
+std::vector<std::string> visible_gpu_ids(const char* inherited,
+                                         const std::vector<int>& cuda_indices);
 
 struct PoolSummary {
   int started = 0, completed = 0, failed = 0, refused = 0, interrupted = 0, lost = 0;

@@ -2,8 +2,10 @@
 # Packs what the GPU machine needs to run the device check into one small
 # folder (the device tool carries at most 64 MiB of ignored paths): the GPU
 # tests, the GPU fluid and coupling benchmarks, the CPU fluid benchmark and flocsim itself, built here with
-# the CUDA back-end, and every shared library they load except the C library
-# and the loader, which the machine has (and the CUDA driver, which is its own).
+# the CUDA back-end, and every shared library they load except the CUDA driver,
+# which is the machine's own. The C library and its loader go apart, in
+# lib/glibc, used only where the machine's own C library is older than the one
+# the bundle was built against (scripts/device-check.sh decides).
 # Usage: scripts/device-bundle.sh [BUILD_DIR] [BUNDLE_DIR]
 #   defaults: build/device  build/device-bundle
 # Build first with the device preset (x86-64-v3: the GPU machine's processor
@@ -36,20 +38,31 @@ if [[ ! -f $build/engine/libflocsim_lattice_gpu_kernels.a ]]; then
   exit 2
 fi
 rm -rf "$bundle.tmp"
-mkdir -p "$bundle.tmp/bin" "$bundle.tmp/lib"
+mkdir -p "$bundle.tmp/bin" "$bundle.tmp/lib/glibc"
 cp "${programs[@]}" "$bundle.tmp/bin/"
-# libraries: everything ldd resolves, less the C library and the libraries
-# that come with it (they must match the machine's own C library: some use its
-# private symbols) and the CUDA driver, which is the machine's own
+# libraries: everything ldd resolves, less the CUDA driver (the machine's
+# own). The C library, its loader and the libraries that come with it (they
+# use each other's private symbols, so they go together or not at all) go to
+# lib/glibc: the programs and the libraries built here on Debian 12 want
+# symbols of its C library (2.36: arc4random in libstdc++, hypot@2.35), which
+# an older machine (Ubuntu 22.04: 2.35; RHEL 9: 2.34) lacks; there the device
+# check starts each program through the bundled loader instead.
 for p in "${programs[@]}"; do
-  ldd "$p" | awk '/=> \// {print $3}'
+  ldd "$p" | awk '/=> \// {print $3} /^[[:space:]]*\/.*ld-linux/ {print $1}'
 done | sort -u | while read -r lib; do
   case "$(basename "$lib")" in
+    libcuda.so.*|libnss_*) ;;
     libc.so.*|libm.so.*|ld-linux*|libpthread.so.*|libdl.so.*|librt.so.*|libresolv.so.*|\
-      libnsl.so.*|libutil.so.*|libanl.so.*|libmvec.so.*|libnss_*|libcuda.so.*) ;;
+      libnsl.so.*|libutil.so.*|libanl.so.*|libmvec.so.*) cp -L "$lib" "$bundle.tmp/lib/glibc/" ;;
     *) cp -L "$lib" "$bundle.tmp/lib/" ;;
   esac
 done
+if ! ls "$bundle.tmp"/lib/glibc/ld-linux* > /dev/null 2>&1; then
+  echo "device-bundle: the loader (ld-linux*) was not found by ldd" >&2
+  exit 1
+fi
+# its version, for the device check's comparison with the machine's
+ldd --version | head -n 1 | grep -o "[0-9]\+\.[0-9]\+$" > "$bundle.tmp/lib/glibc/version.txt"
 # The vector instructions the build assumed, which the device check looks for
 # in the processor before it starts: a native build's are this processor's
 # (more than any other may have); the device preset's are x86-64-v3's.

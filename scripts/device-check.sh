@@ -10,7 +10,8 @@
 # holds it and a rerun.
 #
 # Time limits per step: 50 + 55 + 85 + 80 + 40 + 4 x 25 + 2 x 35 = 480 s at
-# most, each with 15 s more for a step that ignores SIGTERM (a hung kernel).
+# most, each with 5 s more for a step that ignores SIGTERM (a hung kernel):
+# 535 s, inside the device tool's 600 s for one command.
 # Usage (from the repository root, on the GPU machine):
 #   scripts/device-check.sh [BUNDLE] [OUT]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
@@ -18,7 +19,8 @@
 # The device tool brings back at most 8 files of 16 MiB from OUT, so every log,
 # result and benchmark file is written to a scratch folder beside the bundle and
 # OUT gets three: summary.txt and machine.txt (kept current as steps run) and
-# device-check.tgz (the scratch folder without checkpoints) at the end.
+# device-check.tgz (the scratch folder without checkpoints), repacked after
+# each step.
 # Exit 0 when every step ran and every GPU test passed; 1 otherwise (each
 # step's log says which); 2 when the bundle is missing.
 set -uo pipefail
@@ -37,10 +39,12 @@ bundle=$(realpath "$bundle")
 work="$root/device-check-work"  # everything but the summary; tarred into $out at the end
 rm -rf "$work"
 mkdir -p "$work"
+host_library_path=${LD_LIBRARY_PATH:-}  # where the machine keeps its libraries (the CUDA driver's)
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export FLOCSIM_EXE="$bundle/bin/flocsim" FLOCSIM_SOURCE_DIR="$root"
 export OMP_WAIT_POLICY=passive
 status=0
+last_rc=0  # the exit code of the step that ran last
 ok_codes="0"  # the exit codes a step may end with
 started=$(date +%s)
 
@@ -79,8 +83,35 @@ if [[ -f $bundle/cpu-flags.txt ]]; then
 fi
 
 # Every shared library the programs need must resolve from the bundle or the
-# machine (the C library's version among them).
+# machine. Where the machine's C library is older than the one the bundle was
+# built against ("version `GLIBC_2.36' not found"), each program starts
+# through the bundle's own loader and C library (lib/glibc) instead: wrappers
+# in the scratch folder, which FLOCSIM_EXE names too, so the tests' child runs
+# take the same way. The machine's own tools keep the machine's C library.
+# DEVICE_CHECK_BUNDLED_LIBC=1 takes that way on any machine (to try it here).
+bin="$bundle/bin"
 ldd "$bundle"/bin/* > "$work/ldd.txt" 2>&1
+if grep -q "version .GLIBC_[0-9.]*. not found" "$work/ldd.txt" || [[ ${DEVICE_CHECK_BUNDLED_LIBC:-} == 1 ]]; then
+  loader=$(ls "$bundle"/lib/glibc/ld-linux* 2> /dev/null | head -n 1)
+  why="older than the bundle's ($(cat "$bundle/lib/glibc/version.txt" 2> /dev/null))"
+  [[ ${DEVICE_CHECK_BUNDLED_LIBC:-} == 1 ]] && why="set aside (DEVICE_CHECK_BUNDLED_LIBC=1)"
+  echo "device-check: the machine's C library ($(ldd --version 2>&1 | head -n 1)) is $why:" \
+       "the programs start through the bundled loader" \
+       "${loader:-(missing: repack with scripts/device-bundle.sh)}" | tee -a "$out/summary.txt"
+  libpath="$bundle/lib/glibc:$bundle/lib${host_library_path:+:$host_library_path}"
+  mkdir -p "$work/bin"
+  for p in "$bundle"/bin/*; do
+    printf '#!/bin/sh\nexec "%s" --library-path "%s" "%s" "$@"\n' "$loader" "$libpath" "$p" \
+      > "$work/bin/$(basename "$p")"
+    chmod +x "$work/bin/$(basename "$p")"
+  done
+  bin="$work/bin"
+  export FLOCSIM_EXE="$bin/flocsim"
+  for p in "$bundle"/bin/*; do
+    echo "$p:"
+    "$loader" --library-path "$libpath" --list "$p"
+  done > "$work/ldd.txt" 2>&1
+fi
 if grep -E "not found" "$work/ldd.txt" | tee -a "$out/summary.txt" | grep -q .; then
   echo "device-check: unresolved libraries above (ldd.txt in device-check.tgz)" |
     tee -a "$out/summary.txt"
@@ -94,34 +125,47 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
   echo "== $name ($(($(date +%s) - started)) s in)" | tee -a "$out/summary.txt"
   # line-buffered, so a step killed at its limit leaves what it printed; -k:
   # a step stuck in a kernel ignores SIGTERM (it is checked between steps)
-  timeout -k 15 "$limit" stdbuf -oL -eL "$@" > "$work/$name.log" 2>&1
+  timeout -k 5 "$limit" stdbuf -oL -eL "$@" > "$work/$name.log" 2>&1
   local rc=$?
   echo "   exit $rc" | tee -a "$out/summary.txt"
   tail -n 25 "$work/$name.log"
   [[ " $ok_codes " == *" $rc "* ]] || status=1
+  last_rc=$rc
+  # what has run so far, into OUT now: should the device tool stop the
+  # script at its limit, the logs up to there still come back
+  pack > /dev/null
 }
 
 
 # 1. the GPU against the CPU reference (tests/lattice_gpu; tests/coupling_gpu:
 #    the immersed boundary and the liquid averages, a 200-step suspension run
 #    on each device among them)
-step gpu-tests 50 "$bundle/bin/test_gpu_lattice" --gtest_output="json:$work/gpu-tests.json"
-step gpu-coupling-tests 55 "$bundle/bin/test_gpu_coupling" \
+step gpu-tests 50 "$bin/test_gpu_lattice" --gtest_output="json:$work/gpu-tests.json"
+# 77: no usable GPU (no driver, one too old for CUDA 13, none visible): every
+# later GPU step would say the same, so stop here with the reason
+if ((last_rc == 77)); then
+  grep -m 1 "no GPU" "$work/gpu-tests.log" | tee -a "$out/summary.txt"
+  echo "device-check: no usable GPU (above); stopped before the other steps" |
+    tee -a "$out/summary.txt"
+  pack
+  exit 1
+fi
+step gpu-coupling-tests 55 "$bin/test_gpu_coupling" \
   --gtest_output="json:$work/gpu-coupling-tests.json"
 
 # 2. the fluid kernel: paper's box and 256^3, float and double, against the
 #    device's copy bandwidth
-step bench-fluid-gpu 85 "$bundle/bin/bench_fluid_gpu" --reps 5 --steps 100 \
+step bench-fluid-gpu 85 "$bin/bench_fluid_gpu" --reps 5 --steps 100 \
   --json "$work/bench-fluid-gpu.json"
 
 # 2b. the coupled step on the paper's case (a = 6, N = 1320): the immersed
 #     boundary's presets' schemes, float and double, against the fluid alone
-step bench-coupling-gpu 80 "$bundle/bin/bench_coupling_gpu" --reps 5 --steps 20 \
+step bench-coupling-gpu 80 "$bin/bench_coupling_gpu" --reps 5 --steps 20 \
   --json "$work/bench-coupling-gpu.json"
 
 # 3. the CPU kernel on this machine's cores at 256^3, the GPU's second box,
 #    for the speed-up
-step bench-fluid-cpu 40 "$bundle/bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
+step bench-fluid-cpu 40 "$bin/bench_fluid" --threads "$(nproc)" --reps 3 --steps 10 \
   --size 256 --precision all --forcing uniform --json "$work/bench-fluid-cpu.json"
 
 # 4. the fluid scene at the paper's box (288 x 144 x 144): a shear wave with
@@ -136,7 +180,7 @@ for precision in float double; do
            "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
  "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
 CASE
-    step "run-paper-box-$precision-$device" 25 "$bundle/bin/flocsim" run \
+    step "run-paper-box-$precision-$device" 25 "$bin/flocsim" run \
       "$work/paper-box-$precision-$device.json" --out "$work/run-paper-box-$precision-$device" --quiet
   done
 done
@@ -153,7 +197,7 @@ for device in cuda cpu; do
   steps=1500
   [[ $device == cpu ]] && steps=30
   ok_codes="0 3"  # a stop on request exits 3: that is this step's success
-  step "run-paper-case-$device" 35 "$bundle/bin/flocsim" run "$work/paper-case.json" \
+  step "run-paper-case-$device" 35 "$bin/flocsim" run "$work/paper-case.json" \
     --out "$work/run-paper-case-$device" --device "$device" --stop-after "$steps" --quiet
   ok_codes="0"
 done

@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -137,10 +138,12 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 
 // --device cuda is checked before anything is recorded or started: the build
 // and (local backend) this machine must have a GPU, and every point of the
-// grid must be a case that runs on one. Returns the GPUs the pool spreads
-// its workers over (1 where they are not counted here).
-int check_device(const SweepOptions& o, const std::vector<orc::RunPoint>& points) {
-  if (o.device != "cuda") return 1;
+// grid must be a case that runs on one. Returns what CUDA_VISIBLE_DEVICES
+// names each GPU the pool spreads its workers over by (none where they are
+// not counted here: on the CPU, or on Slurm, which gives each task its own).
+std::vector<std::string> check_device(const SweepOptions& o,
+                                      const std::vector<orc::RunPoint>& points) {
+  if (o.device != "cuda") return {};
   const gpu::GpuQuery q = gpu::query_gpus();
   if (!gpu::built_with_cuda() || (o.backend == "local" && q.devices.empty()))
     throw flocsim::input::InputError("--device cuda: " + q.why_none +
@@ -155,11 +158,14 @@ int check_device(const SweepOptions& o, const std::vector<orc::RunPoint>& points
                                        e.what());
     }
   }
-  return q.devices.empty() ? 1 : static_cast<int>(q.devices.size());
+  std::vector<int> indices;
+  for (const gpu::GpuDevice& d : q.devices) indices.push_back(d.index);
+  gpu::release_gpus();  // the workers take them; this process runs nothing there
+  return orc::visible_gpu_ids(std::getenv("CUDA_VISIBLE_DEVICES"), indices);
 }
 
 int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
-              std::vector<RunState> states, int gpus) {
+              std::vector<RunState> states, const std::vector<std::string>& gpu_ids) {
   if (o.backend == "slurm") {
     orc::SlurmLaunch launch;
     launch.worker = o.worker.empty() ? default_worker() : o.worker;
@@ -183,7 +189,8 @@ int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& s
   p.lease_s = o.lease_s;
   p.grace_s = o.grace_s;
   p.device = o.device;
-  p.gpus = gpus;
+  p.gpus = std::max(1, static_cast<int>(gpu_ids.size()));
+  p.gpu_ids = gpu_ids;
   p.out = &std::cout;
   process::install_stop_handlers(process::SecondSignal::is_counted);
   const orc::PoolSummary s = orc::run_pool(db, sweep, p);
@@ -336,7 +343,7 @@ const bool registered = register_command(
            if (*action == "launch") {
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
              // a grid refused here leaves no database file behind
-             const int gpus = check_device(*o, orc::expand(spec));
+             const std::vector<std::string> gpus = check_device(*o, orc::expand(spec));
              check_worker(o->worker);
              db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
              if (o->worker.empty() && !std::getenv("FLOCSIM_WORKER")) {
@@ -372,7 +379,7 @@ const bool registered = register_command(
                                    r.point_json.empty()
                                        ? nlohmann::ordered_json::object()
                                        : nlohmann::ordered_json::parse(r.point_json)});
-             const int gpus = check_device(*o, points);
+             const std::vector<std::string> gpus = check_device(*o, points);
              return run_sweep(
                  *o, db, sweep,
                  {RunState::kPending, RunState::kInterrupted, RunState::kLost, RunState::kFailed},

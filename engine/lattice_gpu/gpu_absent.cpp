@@ -24,6 +24,8 @@ GpuQuery query_gpus() {
   return {{}, kNoCuda};
 }
 
+void release_gpus() {}
+
 GpuDevice use_first_gpu() {
   throw std::runtime_error(kNoCuda);
 }

@@ -31,7 +31,9 @@ GpuQuery query_gpus() {
     cudaGetLastError();  // clear the sticky error of a failed query
     return q;
   }
-  std::string too_old;
+  std::string too_old, unavailable;
+  int current = 0;
+  const bool had_current = cudaGetDevice(&current) == cudaSuccess;
   for (int d = 0; d < count; ++d) {
     cudaDeviceProp p{};
     if (cudaGetDeviceProperties(&p, d) != cudaSuccess) continue;
@@ -42,17 +44,46 @@ GpuQuery query_gpus() {
                  std::to_string(p.major) + "." + std::to_string(p.minor) + ")";
       continue;
     }
+    // Its free memory needs a context on it; a GPU that gives none (held by
+    // another process in exclusive mode, or failed) cannot run a case here.
     std::size_t free = 0, total = 0;
-    if (cudaSetDevice(d) == cudaSuccess) cudaMemGetInfo(&free, &total);
+    cudaError_t got = cudaSetDevice(d);
+    if (got == cudaSuccess) got = cudaMemGetInfo(&free, &total);
+    if (got != cudaSuccess) {
+      unavailable += std::string(unavailable.empty() ? "" : "; ") + p.name + " (CUDA index " +
+                     std::to_string(d) + "): " + cudaGetErrorString(got);
+      cudaGetLastError();  // not sticky: the next GPU is asked afresh
+      continue;
+    }
     q.devices.push_back({d, p.name, static_cast<double>(p.totalGlobalMem) / (1u << 30),
                          static_cast<double>(free) / (1u << 30), p.major, p.minor});
   }
-  if (q.devices.empty())
+  // the caller's current GPU stays current (the loop made each one current)
+  if (had_current) cudaSetDevice(current);
+  if (q.devices.empty() && !too_old.empty())
     q.why_none = "the visible GPUs are older than this build's code (compute capability " +
                  std::to_string(FLOCSIM_CUDA_MIN_ARCH / 10) + "." +
                  std::to_string(FLOCSIM_CUDA_MIN_ARCH % 10) + " and newer): " + too_old +
                  "; configure with -DCMAKE_CUDA_ARCHITECTURES=<theirs> to build for them";
+  if (q.devices.empty() && !unavailable.empty())
+    q.why_none += std::string(q.why_none.empty() ? "" : "; ") +
+                  "the visible GPUs cannot be used by this process (busy in exclusive mode, "
+                  "or failed; nvidia-smi says which): " +
+                  unavailable;
+  if (q.devices.empty() && q.why_none.empty())
+    q.why_none = "no visible GPU answered the query of its properties";
   return q;
+}
+
+void release_gpus() {
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess) {
+    cudaGetLastError();
+    return;
+  }
+  for (int d = 0; d < count; ++d)
+    if (cudaSetDevice(d) == cudaSuccess) cudaDeviceReset();
+  cudaGetLastError();
 }
 
 GpuDevice use_first_gpu() {

@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 #include <tuple>
+#include <vector>
 
 #include "db/results_db.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
@@ -59,6 +60,38 @@ TEST_F(Orchestrator, WorkersOnCudaGetTheirOwnGpuThenShare) {
   EXPECT_EQ(gpu_of[1], "0");
   EXPECT_EQ(gpu_of[2], "1");
   EXPECT_EQ(gpu_of[3], "0");
+}
+
+TEST_F(Orchestrator, WorkersGetTheGpusTheOrchestratorWasGivenNotTheMachinesFirst) {
+  // An orchestrator started with CUDA_VISIBLE_DEVICES=5,7 sees those two GPUs
+  // as CUDA indices 0 and 1; a worker given "0" would run on the machine's
+  // GPU 0, which is not its to use. Its workers must be given "5" and "7".
+  const flocsim::orchestrator::SweepSpec spec =
+      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 50));
+  ResultsDb db(db_, ResultsDb::Mode::kCreate);
+  const flocsim::orchestrator::Registered reg =
+      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = 2;
+  p.device = "cuda";
+  p.gpus = 2;
+  p.gpu_ids = flocsim::orchestrator::visible_gpu_ids("5,7", {0, 1});
+  ASSERT_EQ(flocsim::orchestrator::run_pool(db, reg.sweep, p).completed, 2);
+  EXPECT_EQ(t::read_text(run_dir(1) / "devices.log"), "device cuda gpu 5\n");
+  EXPECT_EQ(t::read_text(run_dir(2) / "devices.log"), "device cuda gpu 7\n");
+}
+
+TEST(VisibleGpuIds, MapCudaIndicesThroughTheInheritedList) {
+  using flocsim::orchestrator::visible_gpu_ids;
+  using V = std::vector<std::string>;
+  // no list of its own: the CUDA index is the machine's
+  EXPECT_EQ(visible_gpu_ids(nullptr, {0, 1, 2}), (V{"0", "1", "2"}));
+  // a list: index i is its i-th entry, spaces trimmed; UUIDs pass as given
+  EXPECT_EQ(visible_gpu_ids("2, 3", {0, 1}), (V{"2", "3"}));
+  EXPECT_EQ(visible_gpu_ids("GPU-8f1c,GPU-02ab", {1}), (V{"GPU-02ab"}));
+  // a GPU the query left out (too old, busy) leaves its entry unused
+  EXPECT_EQ(visible_gpu_ids("4,6,9", {0, 2}), (V{"4", "9"}));
 }
 
 TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
