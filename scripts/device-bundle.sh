@@ -61,8 +61,18 @@ if ! ls "$bundle.tmp"/lib/glibc/ld-linux* > /dev/null 2>&1; then
   echo "device-bundle: the loader (ld-linux*) was not found by ldd" >&2
   exit 1
 fi
-# its version, for the device check's comparison with the machine's
-ldd --version | head -n 1 | grep -o "[0-9]\+\.[0-9]\+$" > "$bundle.tmp/lib/glibc/version.txt"
+# The rest of the C library's family, which the programs do not name but the
+# machine's CUDA driver (loaded at run time) does: with the bundled C library
+# these must be its companions too, not the machine's (below glibc 2.34 they
+# are real libraries that use their own C library's private symbols).
+libc_dir=$(dirname "$(ldd "${programs[-1]}" | awk '/libc\.so\.6 => \// {print $3}')")
+for name in libpthread.so.0 libdl.so.2 librt.so.1 libutil.so.1 libanl.so.1 libmvec.so.1; do
+  [[ -e $libc_dir/$name ]] && cp -L "$libc_dir/$name" "$bundle.tmp/lib/glibc/"
+done
+# its version, for the device check's comparison with the machine's (sed reads
+# all of ldd's output: `head` would end the pipe early, and ldd's SIGPIPE
+# would stop this script under pipefail)
+ldd --version 2>&1 | sed -n '1s/.* //p' > "$bundle.tmp/lib/glibc/version.txt"
 # The vector instructions the build assumed, which the device check looks for
 # in the processor before it starts: a native build's are this processor's
 # (more than any other may have); the device preset's are x86-64-v3's.

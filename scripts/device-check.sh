@@ -65,7 +65,9 @@ started=$(date +%s)
 cat "$out/machine.txt"
 
 pack() {  # the scratch folder into OUT, without checkpoints (each about 1 GB)
-  tar czf "$out/device-check.tgz" --exclude='*.h5' -C "$work" . 2> /dev/null
+  # checkpoints (*.h5) and any half-written one (.NAME.tmp.*, left by a step
+  # killed while it wrote) stay out: each is about 1 GB
+  tar czf "$out/device-check.tgz" --exclude='*.h5' --exclude='.*.tmp.*' -C "$work" . 2> /dev/null
   ls -la "$out"
 }
 
@@ -101,13 +103,22 @@ if grep -q "version .GLIBC_[0-9.]*. not found" "$work/ldd.txt" || [[ ${DEVICE_CH
   libpath="$bundle/lib/glibc:$bundle/lib${host_library_path:+:$host_library_path}"
   mkdir -p "$work/bin"
   for p in "$bundle"/bin/*; do
-    printf '#!/bin/sh\nexec "%s" --library-path "%s" "%s" "$@"\n' "$loader" "$libpath" "$p" \
+    printf '#!/bin/bash\nexec %q --library-path %q %q "$@"\n' "$loader" "$libpath" "$p" \
       > "$work/bin/$(basename "$p")"
     chmod +x "$work/bin/$(basename "$p")"
   done
   bin="$work/bin"
-  export FLOCSIM_EXE="$bin/flocsim"
-  for p in "$bundle"/bin/*; do
+  # the tests' child runs; a sweep's workers would need FLOCSIM_WORKER too
+  # (through the loader, /proc/self/exe names the loader)
+  export FLOCSIM_EXE="$bin/flocsim" FLOCSIM_WORKER="$bin/flocsim"
+  # the machine's own tools (nvidia-smi, nvcc, tar) keep the machine's
+  # libraries: the bundle's want the newer C library
+  export LD_LIBRARY_PATH="$host_library_path"
+  [[ -z $LD_LIBRARY_PATH ]] && unset LD_LIBRARY_PATH
+  # the programs, and the machine's CUDA driver as they will load it (its
+  # dependencies must resolve to the bundled C library's family)
+  libcuda=$(ldconfig -p 2> /dev/null | awk '/libcuda\.so\.1 / {print $NF; exit}')
+  for p in "$bundle"/bin/* $libcuda; do
     echo "$p:"
     "$loader" --library-path "$libpath" --list "$p"
   done > "$work/ldd.txt" 2>&1

@@ -139,8 +139,8 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 // --device cuda is checked before anything is recorded or started: the build
 // and (local backend) this machine must have a GPU, and every point of the
 // grid must be a case that runs on one. Returns what CUDA_VISIBLE_DEVICES
-// names each GPU the pool spreads its workers over by (none where they are
-// not counted here: on the CPU, or on Slurm, which gives each task its own).
+// names each GPU the local pool spreads its workers over by (none on the
+// CPU; on Slurm, which gives each task its own GPU, they go unused).
 std::vector<std::string> check_device(const SweepOptions& o,
                                       const std::vector<orc::RunPoint>& points) {
   if (o.device != "cuda") return {};

@@ -32,6 +32,9 @@ GpuQuery query_gpus() {
     return q;
   }
   std::string too_old, unavailable;
+  // cudaGetDevice answers 0 even before anything chose a GPU: restored below
+  // only if that GPU proves usable (setting an unusable one would leave an
+  // error for the next launch to report)
   int current = 0;
   const bool had_current = cudaGetDevice(&current) == cudaSuccess;
   for (int d = 0; d < count; ++d) {
@@ -59,7 +62,11 @@ GpuQuery query_gpus() {
                          static_cast<double>(free) / (1u << 30), p.major, p.minor});
   }
   // the caller's current GPU stays current (the loop made each one current)
-  if (had_current) cudaSetDevice(current);
+  const bool current_usable =
+      std::any_of(q.devices.begin(), q.devices.end(),
+                  [current](const GpuDevice& d) { return d.index == current; });
+  if (had_current && current_usable) cudaSetDevice(current);
+  cudaGetLastError();  // nothing of the query is left for the next call to report
   if (q.devices.empty() && !too_old.empty())
     q.why_none = "the visible GPUs are older than this build's code (compute capability " +
                  std::to_string(FLOCSIM_CUDA_MIN_ARCH / 10) + "." +
