@@ -28,14 +28,19 @@ double viscosity_floor(const SuspensionCase& c, double radius) {
   return multi_sweep_suspension(c) ? std::max(lattice, kSmallestMultiSweepViscosity) : lattice;
 }
 
+// Whether nu = 2 a U_inf / Re_inf reaches this case's floor at a_over_dx =
+// radius with U_inf within the Mach limit.
+bool reaches_floor_within_mach(const SuspensionCase& c, double radius) {
+  return 2 * radius * kMaxSettlingVelocity >=
+         viscosity_floor(c, radius) * c.physics.reynolds_inf * (1 - 1e-9);
+}
+
 // The smallest resolution with shipped calibrations (radius and close pairs
-// for both immersed-boundary options) above this case's a at which nu = 2 a
-// U_inf / Re_inf reaches the floor within the Mach limit; 0 where none does.
+// for both immersed-boundary options) above this case's a at which the floor
+// is reached within the Mach limit; 0 where none does.
 double finer_resolution_reaching_floor(const SuspensionCase& c) {
   for (double calibrated : {4.0, 6.0, 8.0})
-    if (calibrated > c.numerics.radius_cells &&
-        2 * calibrated * kMaxSettlingVelocity >=
-            viscosity_floor(c, calibrated) * c.physics.reynolds_inf * (1 - 1e-9))
+    if (calibrated > c.numerics.radius_cells && reaches_floor_within_mach(c, calibrated))
       return calibrated;
   return 0;
 }
@@ -168,7 +173,8 @@ void check_stability_floor(const SuspensionCase& c) {
 // 0.02 stayed clean; the one-sweep option stayed clean at nu = 0.01. At a = 6
 // the same onset (nu 0.0067 stopped by the coupling monitor at phi 0.2 and
 // 0.32 after 170-177 a/U_inf, 0.01 at or over its limit at Re_inf 72, 0.0133
-// completed 600 a/U_inf at phi 0.32).
+// completed 600 a/U_inf at phi 0.32; a = 8 on the floor ran 200 a/U_inf at
+// 0.31 of the monitor's limit, phi 0.32, Re_inf 72).
 void check_multi_sweep_floor(const SuspensionCase& c, bool viscosity_given,
                              bool settling_velocity_given) {
   if (!multi_sweep_oscillates(c)) return;
@@ -176,9 +182,9 @@ void check_multi_sweep_floor(const SuspensionCase& c, bool viscosity_given,
   const double a = c.numerics.radius_cells, re = c.physics.reynolds_inf;
   const double nu_floor = kSmallestMultiSweepViscosity;
   const double u_needed = settling_velocity_at_multi_sweep_floor(c);
-  // nu = 2 a U_inf / Re_inf reaches the floor within the Mach limit at this
-  // a, or at the smallest finer calibrated one
-  const bool reaches_floor_here = 2 * a * kMaxSettlingVelocity >= nu_floor * re * (1 - 1e-9);
+  // the floor within the Mach limit at this a, or at the smallest finer
+  // calibrated one
+  const bool reaches_floor_here = reaches_floor_within_mach(c, a);
   const double finer = finer_resolution_reaching_floor(c);
   if (viscosity_given) {
     if (reaches_floor_here)

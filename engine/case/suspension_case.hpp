@@ -42,8 +42,9 @@ inline constexpr double kMaxSettlingVelocityWithoutLiquid = 0.05;
 // 36-72): nu 0.0067 stopped by the coupling monitor at both phi, 0.01 at or
 // over its limit at Re_inf 72; at 0.0133 a run of the paper's length (600
 // a/U_inf, phi 0.32, Re_inf 60) completed with its worst window at 0.72 of
-// the limit. So one floor at every resolution (at a = 8 and above assumed,
-// not measured); the monitor stops a run that crosses it all the same.
+// the limit. So one floor at every resolution (at a = 8 one probe on it, phi
+// 0.32, Re_inf 72, 200 a/U_inf: 0.31 of the limit; above a = 8 assumed); the
+// monitor stops a run that crosses it all the same.
 inline constexpr double kSmallestMultiSweepViscosity = 0.04 / 3;
 // Largest lattice viscosity accepted in a scene with liquid, whether given
 // (numerics.viscosity) or implied by Re_inf and U_inf (nu = 2 a U_inf /

@@ -30,23 +30,35 @@ using namespace flocsim::test::orchestrator_fixture;
 
 namespace {
 
+// The sweep file recorded in `db`, its run folders under dir/runs.
+flocsim::db::SweepRecord registered(ResultsDb& db, const std::string& sweep_file,
+                                    const fs::path& dir) {
+  return flocsim::orchestrator::register_sweep(
+             db, flocsim::orchestrator::read_sweep_file(sweep_file), (dir / "runs").string())
+      .sweep;
+}
+
+// A pool of `jobs` fake workers.
+flocsim::orchestrator::PoolOptions fake_pool(int jobs) {
+  flocsim::orchestrator::PoolOptions p;
+  p.worker = FAKE_WORKER_EXE;
+  p.jobs = jobs;
+  return p;
+}
+
 TEST_F(Orchestrator, WorkersOnCudaGetTheirOwnGpuThenShare) {
   // The pool on two GPUs with three workers at once (six runs, each long
   // enough that the three overlap): every worker is told --device cuda, the
   // first two get GPUs 0 and 1, and the third shares one. The command line
   // refuses --device cuda where no GPU is usable, so this drives the pool
   // itself, as `sweep launch` does once the GPUs are counted.
-  const flocsim::orchestrator::SweepSpec spec =
-      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2, 3, 4, 5, 6}, 6, 50));
   ResultsDb db(db_, ResultsDb::Mode::kCreate);
-  const flocsim::orchestrator::Registered reg =
-      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
-  flocsim::orchestrator::PoolOptions p;
-  p.worker = FAKE_WORKER_EXE;
-  p.jobs = 3;
+  const flocsim::db::SweepRecord sweep =
+      registered(db, fake_sweep({1, 2, 3, 4, 5, 6}, 6, 50), dir_);
+  flocsim::orchestrator::PoolOptions p = fake_pool(3);
   p.device = "cuda";
   p.gpus = 2;
-  const flocsim::orchestrator::PoolSummary s = flocsim::orchestrator::run_pool(db, reg.sweep, p);
+  const flocsim::orchestrator::PoolSummary s = flocsim::orchestrator::run_pool(db, sweep, p);
   EXPECT_EQ(s.completed, 6);
   std::map<double, std::string> gpu_of;
   for (double x : {1, 2, 3, 4, 5, 6}) {
@@ -66,18 +78,13 @@ TEST_F(Orchestrator, WorkersGetTheGpusTheOrchestratorWasGivenNotTheMachinesFirst
   // An orchestrator started with CUDA_VISIBLE_DEVICES=5,7 sees those two GPUs
   // as CUDA indices 0 and 1; a worker given "0" would run on the machine's
   // GPU 0, which is not its to use. Its workers must be given "5" and "7".
-  const flocsim::orchestrator::SweepSpec spec =
-      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 50));
   ResultsDb db(db_, ResultsDb::Mode::kCreate);
-  const flocsim::orchestrator::Registered reg =
-      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
-  flocsim::orchestrator::PoolOptions p;
-  p.worker = FAKE_WORKER_EXE;
-  p.jobs = 2;
+  const flocsim::db::SweepRecord sweep = registered(db, fake_sweep({1, 2}, 2, 50), dir_);
+  flocsim::orchestrator::PoolOptions p = fake_pool(2);
   p.device = "cuda";
   p.gpus = 2;
   p.gpu_ids = flocsim::orchestrator::visible_gpu_ids("5,7", {0, 1});
-  ASSERT_EQ(flocsim::orchestrator::run_pool(db, reg.sweep, p).completed, 2);
+  ASSERT_EQ(flocsim::orchestrator::run_pool(db, sweep, p).completed, 2);
   EXPECT_EQ(t::read_text(run_dir(1) / "devices.log"), "device cuda gpu 5\n");
   EXPECT_EQ(t::read_text(run_dir(2) / "devices.log"), "device cuda gpu 7\n");
 }
@@ -95,15 +102,10 @@ TEST(VisibleGpuIds, MapCudaIndicesThroughTheInheritedList) {
 }
 
 TEST_F(Orchestrator, WorkersOnTheCpuGetNoGpuAndNoDeviceFlagByDefault) {
-  const flocsim::orchestrator::SweepSpec spec =
-      flocsim::orchestrator::read_sweep_file(fake_sweep({1, 2}, 2, 10));
   ResultsDb db(db_, ResultsDb::Mode::kCreate);
-  const flocsim::orchestrator::Registered reg =
-      flocsim::orchestrator::register_sweep(db, spec, (dir_ / "runs").string());
-  flocsim::orchestrator::PoolOptions p;
-  p.worker = FAKE_WORKER_EXE;
-  p.jobs = 2;
-  ASSERT_EQ(flocsim::orchestrator::run_pool(db, reg.sweep, p).completed, 2);
+  const flocsim::db::SweepRecord sweep = registered(db, fake_sweep({1, 2}, 2, 10), dir_);
+  flocsim::orchestrator::PoolOptions p = fake_pool(2);
+  ASSERT_EQ(flocsim::orchestrator::run_pool(db, sweep, p).completed, 2);
   for (double x : {1, 2}) {
     const std::string line = t::read_text(run_dir(x) / "devices.log");
     // the orchestrator's own CUDA_VISIBLE_DEVICES, if any, passes through untouched
