@@ -13,9 +13,12 @@
 # most, each with 5 s more for a step that ignores SIGTERM (a hung kernel):
 # 535 s, inside the device tool's 600 s for one command.
 # Usage (from the repository root, on the GPU machine):
-#   scripts/device-check.sh [BUNDLE] [OUT]
+#   scripts/device-check.sh [BUNDLE] [OUT] [check|runs]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
 #     OUT:    where the figures go (default $OUT, else device-check-out)
+#     check (default): the steps below. runs: after a check that passed, whole
+#       runs on the GPU for the device's remaining minutes instead (the
+#       section "The runs" below; DEVICE_RUNS_LIMIT_S, default 240 s)
 # The device tool brings back at most 8 files of 16 MiB from OUT, so every log,
 # result and benchmark file is written to a scratch folder beside the bundle and
 # OUT gets three: summary.txt and machine.txt (kept current as steps run) and
@@ -24,12 +27,17 @@
 # Exit 0 when every step ran and every GPU test passed; 1 otherwise (each
 # step's log says which); 2 when the bundle is missing.
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/.." || exit 2
 root=$(pwd)
 out=${2:-${OUT:-device-check-out}}
 mkdir -p "$out"
 out=$(realpath "$out")
 bundle=${1:-build/device-bundle}
+what=${3:-check}
+if [[ $what != check && $what != runs ]]; then
+  echo "device-check: third argument '$what': must be check or runs" | tee "$out/summary.txt"
+  exit 2
+fi
 if [[ ! -x $bundle/bin/flocsim ]]; then
   echo "device-check: no bundle at $bundle (bin/flocsim missing): pack one with" \
        "scripts/device-bundle.sh here and carry it" | tee "$out/summary.txt"
@@ -130,13 +138,14 @@ if grep -E "not found" "$work/ldd.txt" | tee -a "$out/summary.txt" | grep -q .; 
   exit 1
 fi
 
+kill_after=5  # seconds a step may take to end after its limit's SIGTERM
 step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit code
   local name=$1 limit=$2
   shift 2
   echo "== $name ($(($(date +%s) - started)) s in)" | tee -a "$out/summary.txt"
   # line-buffered, so a step killed at its limit leaves what it printed; -k:
   # a step stuck in a kernel ignores SIGTERM (it is checked between steps)
-  timeout -k 5 "$limit" stdbuf -oL -eL "$@" > "$work/$name.log" 2>&1
+  timeout -k "$kill_after" "$limit" stdbuf -oL -eL "$@" > "$work/$name.log" 2>&1
   local rc=$?
   echo "   exit $rc" | tee -a "$out/summary.txt"
   tail -n 25 "$work/$name.log"
@@ -147,6 +156,52 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
   pack > /dev/null
 }
 
+
+# The runs: once a check has passed, the device's remaining minutes go to
+# whole runs on the GPU, all launched at once (their workers share the GPU;
+# two OpenMP threads each for the sphere side on the machine's cores), each
+# sweep into its own database in the scratch folder:
+# - gpu-precision-a4: the phi 0.20, Re_inf 12 comparison point and its
+#   baseline in float and double (issue: the float-against-double trade; the
+#   float runs repeat the CPU's committed ones, same seed);
+# - corners-paper, corners-extra-paper: the paper preset's accepted corners
+#   (the refused ones are recorded as refused).
+# DEVICE_RUNS_DEVICE=cpu runs them on the CPU instead (to try the mode here).
+# What is not done by the limit stops with its checkpoint: timeout's SIGTERM
+# reaches the whole process group, each orchestrator asks its workers to
+# checkpoint and waits for them, and the launching shell, which ignores the
+# signal, waits for the orchestrators, up to 60 s (a paper-size checkpoint in
+# double is about 1 GB) before timeout kills what is left. `sweep status`
+# says what completed. Worst case: the limit + 60 + 3 x 25 s.
+if [[ $what == runs ]]; then
+  limit=${DEVICE_RUNS_LIMIT_S:-240}
+  export OMP_NUM_THREADS=2
+  kill_after=60
+  step gpu-runs "$limit" bash -c '
+    flocsim=$1 work=$2 device=$3
+    shift 3
+    pids=()
+    for sweep_jobs in "$@"; do
+      sweep=${sweep_jobs%:*}
+      "$flocsim" sweep launch "sweeps/$sweep.json" --db "$work/$sweep.sqlite" \
+        --runs-dir "$work/runs-$sweep" --jobs "${sweep_jobs#*:}" --device "$device" \
+        > "$work/launch-$sweep.log" 2>&1 &
+      pids+=($!)
+    done
+    trap "" TERM  # set after the launches, so they keep SIGTERM'"'"'s default
+    rc=0  # 1 when any launch failed (its log says why)
+    for pid in "${pids[@]}"; do wait "$pid" || rc=1; done
+    exit $rc' _ "$bin/flocsim" "$work" "${DEVICE_RUNS_DEVICE:-cuda}" gpu-precision-a4:4 corners-paper:4 corners-extra-paper:1
+  for sweep in gpu-precision-a4 corners-paper corners-extra-paper; do
+    { echo "   launch $sweep, its last lines:"; tail -n 5 "$work/launch-$sweep.log"; } |
+      tee -a "$out/summary.txt"
+    kill_after=5
+    step "status-$sweep" 20 "$bin/flocsim" sweep status --db "$work/$sweep.sqlite"
+  done
+  echo "== runs done in $(($(date +%s) - started)) s, status $status" | tee -a "$out/summary.txt"
+  pack
+  exit $status
+fi
 
 # 1. the GPU against the CPU reference (tests/lattice_gpu; tests/coupling_gpu:
 #    the immersed boundary and the liquid averages, a 200-step suspension run

@@ -286,6 +286,18 @@ TEST(ShippedSweeps, ParseAndExpandToTheirGrids) {
   EXPECT_GE(demo.size(), 4u);
   EXPECT_LE(demo.size(), 12u);
   EXPECT_GE(orc::expand(orc::read_sweep_file(dir + "ci.json")).size(), 2u);
+  // the device check's runs: du 0 and 0.025, each in float and double, the
+  // comparison sweep's case otherwise (its float runs are the CPU's reference)
+  const auto trade = orc::expand(orc::read_sweep_file(dir + "gpu-precision-a4.json"));
+  ASSERT_EQ(trade.size(), 4u);
+  const auto comparison = orc::read_sweep_file(dir + "comparison/phi0.20-Re12.json").source["base"];
+  int doubles = 0;
+  for (const auto& run : trade) {
+    doubles += run.case_json["precision"] == "double";
+    for (const char* field : {"phi", "Re_inf", "L_over_a", "numerics", "lubrication_model"})
+      EXPECT_EQ(run.case_json[field], comparison[field]) << field;
+  }
+  EXPECT_EQ(doubles, 2);
 }
 
 }  // namespace
