@@ -18,7 +18,7 @@
 #     OUT:    where the figures go (default $OUT, else device-check-out)
 #     check (default): the steps below. runs: after a check that passed, whole
 #       runs on the GPU for the device's remaining minutes instead (the
-#       section "The runs" below; DEVICE_RUNS_LIMIT_S, default 240 s)
+#       section "The runs" below; DEVICE_RUNS_LIMIT_S, default 240 s, at most 420)
 # The device tool brings back at most 8 files of 16 MiB from OUT, so every log,
 # result and benchmark file is written to a scratch folder beside the bundle and
 # OUT gets three: summary.txt and machine.txt (kept current as steps run) and
@@ -60,7 +60,7 @@ started=$(date +%s)
 # from OUT alone
 {
   date -u
-  nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version --format=csv
+  nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version,compute_mode --format=csv
   nvidia-smi
   nproc
   lscpu | grep -i "model name"
@@ -158,45 +158,90 @@ step() {  # step NAME TIMEOUT_S COMMAND...: runs it, logs it, records its exit c
 
 
 # The runs: once a check has passed, the device's remaining minutes go to
-# whole runs on the GPU, all launched at once (their workers share the GPU;
-# two OpenMP threads each for the sphere side on the machine's cores), each
-# sweep into its own database in the scratch folder:
-# - gpu-precision-a4: the phi 0.20, Re_inf 12 comparison point and its
-#   baseline in float and double (issue: the float-against-double trade; the
-#   float runs repeat the CPU's committed ones, same seed);
-# - corners-paper, corners-extra-paper: the paper preset's accepted corners
-#   (the refused ones are recorded as refused).
-# DEVICE_RUNS_DEVICE=cpu runs them on the CPU instead (to try the mode here).
-# What is not done by the limit stops with its checkpoint: timeout's SIGTERM
-# reaches the whole process group, each orchestrator asks its workers to
-# checkpoint and waits for them, and the launching shell, which ignores the
-# signal, waits for the orchestrators, up to 60 s (a paper-size checkpoint in
-# double is about 1 GB) before timeout kills what is left. `sweep status`
-# says what completed. Worst case: the limit + 60 + 3 x 25 s.
+# whole runs on the GPU, in two groups, one after the other; the sweeps of a
+# group are launched at once (their workers share the GPU; two OpenMP threads
+# each for the sphere side on the machine's cores), each into its own
+# database in the scratch folder:
+# 1. gpu-precision-a4 (4 workers): the phi 0.20, Re_inf 12 comparison point
+#    and its baseline at a = 4 in float and double, the back-end's own figure
+#    (the float-against-double trade; its float runs repeat the CPU's
+#    committed ones, same seed), first because its runs are the shorter;
+# 2. corners-paper (4) and corners-extra-paper (1): the paper preset's
+#    accepted corners (the refused ones are recorded as refused).
+# On a GPU in an exclusive compute mode (one process at a time) each sweep
+# runs alone with one worker. DEVICE_RUNS_DEVICE=cpu runs them on the CPU
+# instead (to try the mode here).
+# What is not done by DEVICE_RUNS_LIMIT_S stops with its checkpoint:
+# timeout's SIGTERM reaches the whole process group, each orchestrator has its
+# workers checkpoint (--grace 45: it kills and records a straggler itself),
+# and the launching shell, which notes the signal and starts no further
+# group, waits for the orchestrators up to 60 s (a paper-size checkpoint in
+# double is about 1 GB) before timeout kills what is left. Worst case: the
+# limit + 60 + 3 x 25 s for the statuses + a few seconds of packing and the
+# machine record; hence the limit's ceiling of 420 s, inside the device
+# tool's 600 s for one command.
 if [[ $what == runs ]]; then
   limit=${DEVICE_RUNS_LIMIT_S:-240}
+  if ! [[ $limit =~ ^[0-9]+$ ]] || ((limit < 1 || limit > 420)); then
+    echo "device-check: DEVICE_RUNS_LIMIT_S = '$limit': must be a whole number of seconds" \
+         "from 1 to 420 (the device tool's 600 s per command less what the mode adds)" |
+      tee -a "$out/summary.txt"
+    exit 2
+  fi
+  groups=("gpu-precision-a4:4" "corners-paper:4 corners-extra-paper:1")
+  if nvidia-smi --query-gpu=compute_mode --format=csv,noheader 2> /dev/null | grep -qi exclusive; then
+    echo "device-check: the GPU is in an exclusive compute mode (one process at a time):" \
+         "each sweep runs alone with one worker" | tee -a "$out/summary.txt"
+    groups=("gpu-precision-a4:1" "corners-paper:1" "corners-extra-paper:1")
+  fi
   export OMP_NUM_THREADS=2
+  # a named worker skips the launch's plan, which would time every
+  # configuration on this machine's CPU before the first worker starts
+  export FLOCSIM_WORKER="$bin/flocsim"
   kill_after=60
+  ok_codes="0 124"  # 124: the limit came first; what ran stopped with its checkpoints
   step gpu-runs "$limit" bash -c '
     flocsim=$1 work=$2 device=$3
     shift 3
-    pids=()
-    for sweep_jobs in "$@"; do
-      sweep=${sweep_jobs%:*}
-      "$flocsim" sweep launch "sweeps/$sweep.json" --db "$work/$sweep.sqlite" \
-        --runs-dir "$work/runs-$sweep" --jobs "${sweep_jobs#*:}" --device "$device" \
-        > "$work/launch-$sweep.log" 2>&1 &
-      pids+=($!)
+    stopping=""
+    trap "stopping=1" TERM  # a trap, not an ignore: the launches keep the default
+    finished() {  # finished PID: its exit code, waiting on through a SIGTERM
+      local code
+      while :; do
+        wait "$1"
+        code=$?
+        kill -0 "$1" 2> /dev/null || return $code
+      done
+    }
+    rc=0  # 1 when a launch was refused (2) or ended in another unexpected way
+    for group in "$@"; do
+      [[ -n $stopping ]] && break
+      pids=() names=()
+      for sweep_jobs in $group; do
+        sweep=${sweep_jobs%:*}
+        "$flocsim" sweep launch "sweeps/$sweep.json" --db "$work/$sweep.sqlite" \
+          --runs-dir "$work/runs-$sweep" --jobs "${sweep_jobs#*:}" --device "$device" \
+          --grace 45 > "$work/launch-$sweep.log" 2>&1 &
+        pids+=($!) names+=("$sweep")
+      done
+      for i in "${!pids[@]}"; do
+        finished "${pids[$i]}"
+        code=$?
+        # 0: all completed; 1: some failed or were refused; 3: stopped at the limit
+        echo "${names[$i]}: sweep launch exit $code"
+        ((code == 0 || code == 1 || code == 3)) || rc=1
+      done
     done
-    trap "" TERM  # set after the launches, so they keep SIGTERM'"'"'s default
-    rc=0  # 1 when any launch failed (its log says why)
-    for pid in "${pids[@]}"; do wait "$pid" || rc=1; done
-    exit $rc' _ "$bin/flocsim" "$work" "${DEVICE_RUNS_DEVICE:-cuda}" gpu-precision-a4:4 corners-paper:4 corners-extra-paper:1
+    exit $rc' _ "$bin/flocsim" "$work" "${DEVICE_RUNS_DEVICE:-cuda}" "${groups[@]}"
+  grep "sweep launch exit" "$work/gpu-runs.log" | tee -a "$out/summary.txt"
+  ok_codes="0"
+  kill_after=5
   for sweep in gpu-precision-a4 corners-paper corners-extra-paper; do
+    [[ -f $work/launch-$sweep.log ]] || continue  # its group never started
     { echo "   launch $sweep, its last lines:"; tail -n 5 "$work/launch-$sweep.log"; } |
       tee -a "$out/summary.txt"
-    kill_after=5
     step "status-$sweep" 20 "$bin/flocsim" sweep status --db "$work/$sweep.sqlite"
+    cat "$work/status-$sweep.log" >> "$out/summary.txt"
   done
   echo "== runs done in $(($(date +%s) - started)) s, status $status" | tee -a "$out/summary.txt"
   pack

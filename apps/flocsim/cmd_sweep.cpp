@@ -138,7 +138,7 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 
 // --device cuda is checked before anything is recorded or started: the build
 // and (local backend) this machine must have a GPU, and every point of the
-// grid must be a case that runs on one. Returns what CUDA_VISIBLE_DEVICES
+// grid that runs at all must be a case that runs on one. Returns what CUDA_VISIBLE_DEVICES
 // names each GPU the local pool spreads its workers over by (none on the
 // CPU; on Slurm, which gives each task its own GPU, they go unused).
 std::vector<std::string> check_device(const SweepOptions& o,
@@ -150,6 +150,15 @@ std::vector<std::string> check_device(const SweepOptions& o,
                                      "; run on the CPU with --device cpu");
   for (const orc::RunPoint& p : points) {
     nlohmann::json c = p.case_json;
+    // a point refused on every device (below a stability floor, say) is the
+    // sweep's business as without --device: its worker records the refusal.
+    // Only what cuda alone cannot run stops the launch here.
+    c["device"] = "cpu";
+    try {
+      cases::parse_case(c);
+    } catch (const flocsim::input::InputError&) {
+      continue;
+    }
     c["device"] = "cuda";
     try {
       cases::parse_case(c);

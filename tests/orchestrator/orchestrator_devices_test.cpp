@@ -153,4 +153,40 @@ TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
   }
 }
 
+TEST_F(Orchestrator, CudaSweepsStopOnlyForWhatCudaAloneCannotRun) {
+  // A grid point refused on every device (here Re_inf 72 at the draft
+  // preset: nu 0.0033 below a = 4's stability floor) is recorded as refused
+  // by its worker, as without --device, and the rest of the sweep runs on the
+  // GPU; a point only cuda refuses (a scene without a liquid) stops the launch
+  // before anything is recorded. Against the stand-in Slurm of the test above.
+  if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
+  const fs::path bin = dir_ / "fake-slurm";
+  fs::create_directories(bin);
+  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+  t::write_text(bin / "sbatch", "#!/bin/sh\necho 4242\n");
+  fs::permissions(bin / "squeue", fs::perms::owner_all);
+  fs::permissions(bin / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  const auto launch = [&](const json& sweep) {
+    t::write_text(dir_ / "sweep.json", sweep.dump());
+    return t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db", db_,
+                           "--backend", "slurm", "--no-wait", "--device", "cuda"}),
+                  {path});
+  };
+  json suspension = json::parse(t::read_text(fs::path(FLOCSIM_SOURCE_DIR) / "sweeps/demo.json"));
+  suspension["axes"] = {{"Re_inf", {6, 72}}};
+  const t::Output accepted = launch(suspension);
+  EXPECT_EQ(accepted.code, 0) << accepted.out;
+  EXPECT_EQ(accepted.out.find("grid point"), std::string::npos) << accepted.out;
+
+  const json granular = {{"name", "granular-on-cuda"},
+                         {"base", json::parse(t::read_text(fs::path(FLOCSIM_SOURCE_DIR) /
+                                                           "examples/granular_gas.json"))},
+                         {"axes", {{"seed", {1, 2}}}}};
+  const t::Output refused = launch(granular);
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("--device cuda: grid point"), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find("granular"), std::string::npos) << refused.out;
+}
+
 }  // namespace
