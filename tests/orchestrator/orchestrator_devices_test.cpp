@@ -121,15 +121,9 @@ TEST_F(Orchestrator, SlurmTasksOnCudaAskForAGpuAndPassTheDevice) {
   // task file tells the task's pool --device cuda. Needs a build with the
   // CUDA back-end (one without refuses --device cuda, tested in test_cli).
   if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
+  const std::string path = stand_in_slurm(
+      "for a in \"$@\"; do echo \"$a\"; done > \"$(dirname \"$0\")/args\"\necho 4242\n");
   const fs::path bin = dir_ / "fake-slurm";
-  fs::create_directories(bin);
-  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
-  t::write_text(bin / "sbatch",
-                "#!/bin/sh\nfor a in \"$@\"; do echo \"$a\"; done > \"$(dirname \"$0\")/args\"\n"
-                "echo 4242\n");
-  fs::permissions(bin / "squeue", fs::perms::owner_all);
-  fs::permissions(bin / "sbatch", fs::perms::owner_all);
-  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
   for (const std::string gres : {"", "gpu:h100:2"}) {
     json sweep = json::parse(t::read_text(fs::path(FLOCSIM_SOURCE_DIR) / "sweeps/ci.json"));
     sweep["name"] = gres.empty() ? "gpu-default" : "gpu-named";
@@ -160,13 +154,7 @@ TEST_F(Orchestrator, CudaSweepsStopOnlyForWhatCudaAloneCannotRun) {
   // GPU; a point only cuda refuses (a scene without a liquid) stops the launch
   // before anything is recorded. Against the stand-in Slurm of the test above.
   if (!flocsim::gpu::built_with_cuda()) GTEST_SKIP() << "this build has no CUDA back-end";
-  const fs::path bin = dir_ / "fake-slurm";
-  fs::create_directories(bin);
-  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
-  t::write_text(bin / "sbatch", "#!/bin/sh\necho 4242\n");
-  fs::permissions(bin / "squeue", fs::perms::owner_all);
-  fs::permissions(bin / "sbatch", fs::perms::owner_all);
-  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  const std::string path = stand_in_slurm("echo 4242\n");
   const auto launch = [&](const json& sweep) {
     t::write_text(dir_ / "sweep.json", sweep.dump());
     return t::run(flocsim({"sweep", "launch", (dir_ / "sweep.json").string(), "--db", db_,

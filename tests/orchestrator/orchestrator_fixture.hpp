@@ -53,6 +53,18 @@ class Orchestrator : public ::testing::Test {
     t::write_text(file, s.dump(2));
     return file;
   }
+  // A stand-in Slurm in dir/fake-slurm: squeue answers nothing, sbatch runs
+  // `sbatch_body` (a shell script's lines). Returns the PATH entry that puts
+  // it first, for t::run's environment.
+  std::string stand_in_slurm(const std::string& sbatch_body) {
+    const fs::path bin = dir_ / "fake-slurm";
+    fs::create_directories(bin);
+    t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
+    t::write_text(bin / "sbatch", "#!/bin/sh\n" + sbatch_body);
+    fs::permissions(bin / "squeue", fs::perms::owner_all);
+    fs::permissions(bin / "sbatch", fs::perms::owner_all);
+    return "PATH=" + bin.string() + ":" + std::getenv("PATH");
+  }
   std::vector<std::string> flocsim(std::vector<std::string> args) {
     args.insert(args.begin(), FLOCSIM_EXE);
     return args;

@@ -248,13 +248,8 @@ TEST_F(Orchestrator, HostileNamesFromADatabaseAreEscapedOnEveryOutput) {
 // (exit 0); an sbatch that never answers held the launch through SIGTERM; and
 // a missing $FLOCSIM_WORKER, unlike --worker, was only found by failing runs.
 TEST_F(Orchestrator, SbatchWithoutAJobIdOrAnswerAndAMissingEnvWorkerAreSaid) {
+  const std::string path = stand_in_slurm("echo 'sbatch: queued somewhere'\n");
   const fs::path bin = dir_ / "fake-slurm";
-  fs::create_directories(bin);
-  t::write_text(bin / "squeue", "#!/bin/sh\nexit 0\n");
-  t::write_text(bin / "sbatch", "#!/bin/sh\necho 'sbatch: queued somewhere'\n");
-  fs::permissions(bin / "squeue", fs::perms::owner_all);
-  fs::permissions(bin / "sbatch", fs::perms::owner_all);
-  const std::string path = "PATH=" + bin.string() + ":" + std::getenv("PATH");
   const std::string sweep = fake_sweep({1}, 1, 1);
   const t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--backend", "slurm",
                                       "--no-wait", "--worker", FAKE_WORKER_EXE}),
