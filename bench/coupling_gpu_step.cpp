@@ -233,7 +233,7 @@ int main(int argc, char** argv) {
   const spheres::SphereSet s = suspension(e, kRadius, 0.2);
   std::printf("GPU: %s; box %d x %d x %d, %zu spheres (phi 0.2, a = 6), %d reps of %d steps\n",
               q.devices[0].name.c_str(), e.nx, e.ny, e.nz, s.size(), reps, steps);
-  std::printf("%-34s %-6s %12s %12s %8s %8s\n", "option", "prec", "fluid MLUPS", "full MLUPS",
+  std::printf("%-64s %-6s %12s %12s %8s %8s\n", "option", "prec", "fluid MLUPS", "full MLUPS",
               "ratio", "+coupling ms");
   nlohmann::json all = nlohmann::json::array();
   for (const auto& scheme : schemes)
@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
       if (precision != "all" && precision != p) continue;
       const nlohmann::json r = p == "float" ? time_option<float>(e, s, scheme, steps, reps)
                                             : time_option<double>(e, s, scheme, steps, reps);
-      std::printf("%-34s %-6s %12.0f %12.0f %7.0f%% %8.3f\n", scheme.describe().c_str(), p.c_str(),
+      std::printf("%-64s %-6s %12.0f %12.0f %7.0f%% %8.3f\n", scheme.describe().c_str(), p.c_str(),
                   r["fluid_MLUPS"].get<double>(), r["full_step_MLUPS"].get<double>(),
                   100 * r["full_over_fluid"].get<double>(), r["coupling_ms"].get<double>());
       all.push_back(r);

@@ -24,6 +24,7 @@
 #include "engine/coupling_gpu/covered_cell_kernels.hpp"
 #include "engine/coupling_gpu/sphere_buffers.cuh"
 #include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/cuda_launch.hpp"
 #include "engine/partially_saturated/covered_cell_body.hpp"
 
 namespace flocsim::gpu {
@@ -185,7 +186,7 @@ void CoveredCellKernels<Real>::cover(GpuFluidLattice<Real>& liquid,
                              sizeof(double) * kCoveringNumbers * n, cudaMemcpyHostToDevice),
              "upload of the covering spheres");
   const CoverLaunch<Real> p = launch_of(liquid, input_radius_, dev.spheres, dev.exchange);
-  cover_kernel<Real><<<static_cast<unsigned>(n), kThreads>>>(p);
+  FLOCSIM_LAUNCH(static_cast<unsigned>(n), kThreads, 0, cover_kernel<Real>)(p);
   cuda_check(cudaGetLastError(), "launch of the cells' coverage");
 }
 
@@ -203,9 +204,9 @@ void CoveredCellKernels<Real>::exchange(GpuFluidLattice<Real>& liquid,
   dev.pending = false;
   if (n == 0) return;
   const CoverLaunch<Real> p = launch_of(liquid, input_radius_, dev.spheres, dev.exchange);
-  exchange_kernel<Real><<<static_cast<unsigned>(n), kThreads>>>(p);
+  FLOCSIM_LAUNCH(static_cast<unsigned>(n), kThreads, 0, exchange_kernel<Real>)(p);
   cuda_check(cudaGetLastError(), "launch of the cells' exchange");
-  clear_kernel<Real><<<static_cast<unsigned>(n), kThreads>>>(p);
+  FLOCSIM_LAUNCH(static_cast<unsigned>(n), kThreads, 0, clear_kernel<Real>)(p);
   cuda_check(cudaGetLastError(), "launch of the coverage's clearing");
   cuda_check(cudaMemcpyAsync(dev.pinned.from_device, dev.exchange,
                              sizeof(double) * kExchangeNumbers * n, cudaMemcpyDeviceToHost),
@@ -223,7 +224,7 @@ void CoveredCellKernels<Real>::withdraw(GpuFluidLattice<Real>& liquid) {
   liquid.cancel_cover();
   if (dev.covered == 0) return;
   const CoverLaunch<Real> p = launch_of(liquid, input_radius_, dev.spheres, dev.exchange);
-  clear_kernel<Real><<<static_cast<unsigned>(dev.covered), kThreads>>>(p);
+  FLOCSIM_LAUNCH(static_cast<unsigned>(dev.covered), kThreads, 0, clear_kernel<Real>)(p);
   cuda_check(cudaGetLastError(), "launch of the coverage's clearing");
   cuda_check(cudaDeviceSynchronize(), "partially saturated cells");
 }

@@ -29,6 +29,7 @@
 #include "engine/immersed_boundary/marker_body.hpp"
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/cuda_launch.hpp"
 
 namespace flocsim::gpu {
 
@@ -145,7 +146,7 @@ template <class Real, int W, bool InShared>
 __global__ void __launch_bounds__(kThreads, sizeof(Real) == 4 ? 2 : 1)
     sphere_kernel(SphereLaunch<Real> p) {
   __shared__ double shared[6][kThreads];
-  extern __shared__ __align__(16) unsigned char box_shared[];
+  FLOCSIM_DYNAMIC_SHARED(unsigned char, box_shared);
   const int s = blockIdx.x;
   const double* pose = p.poses + kPoseNumbers * s;
   const double centre[3] = {pose[0], pose[1], pose[2]};
@@ -394,21 +395,22 @@ void MarkerKernels<Real>::apply(GpuFluidLattice<Real>& liquid, const std::vector
   p.proportional_gain = static_cast<Real>(setup_.proportional_gain);
   if (setup_.control) {
     const long lanes = static_cast<long>(4 * M * n);
-    carried_increment_kernel<Real><<<static_cast<unsigned>((lanes + 255) / 256), 256>>>(
-        dev.increment, dev.marker_force, lanes, static_cast<Real>(setup_.marker_volume));
+    FLOCSIM_LAUNCH(static_cast<unsigned>((lanes + 255) / 256), 256, 0,
+                   carried_increment_kernel<Real>)
+    (dev.increment, dev.marker_force, lanes, static_cast<Real>(setup_.marker_volume));
     cuda_check(cudaGetLastError(), "launch of the carried increments");
   }
   const unsigned blocks = static_cast<unsigned>(n);
   if (in_shared) {
     if (setup_.kernel_width == 3)
-      sphere_kernel<Real, 3, true><<<blocks, kThreads, box_bytes>>>(p);
+      FLOCSIM_LAUNCH(blocks, kThreads, box_bytes, sphere_kernel<Real, 3, true>)(p);
     else
-      sphere_kernel<Real, 2, true><<<blocks, kThreads, box_bytes>>>(p);
+      FLOCSIM_LAUNCH(blocks, kThreads, box_bytes, sphere_kernel<Real, 2, true>)(p);
   } else {
     if (setup_.kernel_width == 3)
-      sphere_kernel<Real, 3, false><<<blocks, kThreads>>>(p);
+      FLOCSIM_LAUNCH(blocks, kThreads, 0, sphere_kernel<Real, 3, false>)(p);
     else
-      sphere_kernel<Real, 2, false><<<blocks, kThreads>>>(p);
+      FLOCSIM_LAUNCH(blocks, kThreads, 0, sphere_kernel<Real, 2, false>)(p);
   }
   cuda_check(cudaGetLastError(), "launch of the immersed boundary");
   cuda_check(cudaMemcpyAsync(dev.pinned.from_device, dev.loads, sizeof(double) * kLoadNumbers * n,

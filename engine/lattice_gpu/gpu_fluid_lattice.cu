@@ -8,6 +8,7 @@
 
 #include "engine/lattice/aa_cell.hpp"
 #include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/cuda_launch.hpp"
 #include "engine/lattice_gpu/gpu_fluid_lattice.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 
@@ -308,17 +309,17 @@ void GpuFluidLattice<Real>::step() {
   if (cover_next_) {
     const DeviceCoverage<Real> cover = device_coverage();
     if (field)
-      aa_step_kernel<Real, true, true>
-          <<<grid, threads>>>(s, even, k, bx, by, bz, F[0], F[1], F[2], cover);
+      FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, true, true>)
+      (s, even, k, bx, by, bz, F[0], F[1], F[2], cover);
     else
-      aa_step_kernel<Real, false, true>
-          <<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr, nullptr, cover);
+      FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, false, true>)
+      (s, even, k, bx, by, bz, nullptr, nullptr, nullptr, cover);
   } else if (field) {
-    aa_step_kernel<Real, true, false>
-        <<<grid, threads>>>(s, even, k, bx, by, bz, F[0], F[1], F[2], DeviceCoverage<Real>{});
+    FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, true, false>)
+    (s, even, k, bx, by, bz, F[0], F[1], F[2], DeviceCoverage<Real>{});
   } else {
-    aa_step_kernel<Real, false, false><<<grid, threads>>>(s, even, k, bx, by, bz, nullptr, nullptr,
-                                                          nullptr, DeviceCoverage<Real>{});
+    FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, false, false>)
+    (s, even, k, bx, by, bz, nullptr, nullptr, nullptr, DeviceCoverage<Real>{});
   }
   cuda_check(cudaGetLastError(), "launch of the lattice step");
   cover_next_ = false;  // one step: the coupling asks again
@@ -334,8 +335,8 @@ namespace {
 template <class Real>
 std::vector<double> block_sums(const AaSlots<Real>& s, bool even, lattice::Vector3 body,
                                Real* const (&force)[3], double* partial, int blocks) {
-  moments_sum_kernel<Real><<<blocks, kReductionThreads>>>(s, even, body.x, body.y, body.z, force[0],
-                                                          force[1], force[2], partial);
+  FLOCSIM_LAUNCH(blocks, kReductionThreads, 0, moments_sum_kernel<Real>)
+  (s, even, body.x, body.y, body.z, force[0], force[1], force[2], partial);
   cuda_check(cudaGetLastError(), "launch of the mass and momentum sums");
   std::vector<double> host(4 * static_cast<std::size_t>(blocks));
   cuda_check(cudaMemcpy(host.data(), partial, sizeof(double) * host.size(), cudaMemcpyDeviceToHost),

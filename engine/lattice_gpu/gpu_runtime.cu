@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/cuda_launch.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 
 namespace flocsim::gpu {
@@ -127,12 +128,12 @@ double measure_copy_bandwidth_gbs(std::size_t bytes, int reps) {
   cudaEvent_t start, stop;
   cudaEventCreate(&start);
   cudaEventCreate(&stop);
-  copy_kernel<<<blocks, threads>>>(in, out, n);  // warm-up
+  FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(in, out, n);  // warm-up
   cuda_check(cudaGetLastError(), "launch of the copy benchmark");
   std::vector<double> rates;
   for (int r = 0; r < reps; ++r) {
     cudaEventRecord(start);
-    copy_kernel<<<blocks, threads>>>(in, out, n);
+    FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(in, out, n);
     cudaEventRecord(stop);
     cuda_check(cudaEventSynchronize(stop), "copy benchmark");
     float ms = 0;

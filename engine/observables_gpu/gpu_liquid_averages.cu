@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/lattice_gpu/cuda_check.hpp"
+#include "engine/lattice_gpu/cuda_launch.hpp"
 #include "engine/observables_gpu/gpu_liquid_averages.hpp"
 
 namespace flocsim::gpu {
@@ -126,8 +127,8 @@ LiquidSums GpuLiquidAverages<Real>::sums(const GpuFluidLattice<Real>& liquid,
                           cudaMemcpyHostToDevice),
                "upload of the sphere centres");
     const int reach = static_cast<int>(std::ceil(radius));
-    mark_solid_kernel<<<static_cast<unsigned>(spheres), kLiquidSumThreads>>>(
-        dev.centres, radius, reach, e.nx, e.ny, e.nz, dev.solid);
+    FLOCSIM_LAUNCH(static_cast<unsigned>(spheres), kLiquidSumThreads, 0, mark_solid_kernel)
+    (dev.centres, radius, reach, e.nx, e.ny, e.nz, dev.solid);
     cuda_check(cudaGetLastError(), "launch of the solid mask");
   }
   LiquidSumInput<Real> in;
@@ -140,8 +141,8 @@ LiquidSums GpuLiquidAverages<Real>::sums(const GpuFluidLattice<Real>& liquid,
   const DeviceForceField<const Real> field = liquid.device_force_field_if_set();
   for (int d = 0; d < 3; ++d) in.field[d] = field.component[d];
   in.solid = dev.solid;
-  liquid_sums_kernel<Real>
-      <<<static_cast<unsigned>(dev.blocks), kLiquidSumThreads>>>(in, dev.partial);
+  FLOCSIM_LAUNCH(static_cast<unsigned>(dev.blocks), kLiquidSumThreads, 0, liquid_sums_kernel<Real>)
+  (in, dev.partial);
   cuda_check(cudaGetLastError(), "launch of the liquid averages");
   cuda_check(cudaMemcpy(dev.host_partial.data(), dev.partial, sizeof(LiquidSums) * dev.blocks,
                         cudaMemcpyDeviceToHost),
