@@ -308,12 +308,13 @@ void GpuFluidLattice<Real>::step() {
   const bool field = F[0] != nullptr;
   if (cover_next_) {
     const DeviceCoverage<Real> cover = device_coverage();
-    if (field)
+    if (field) {
       FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, true, true>)
       (s, even, k, bx, by, bz, F[0], F[1], F[2], cover);
-    else
+    } else {
       FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, false, true>)
       (s, even, k, bx, by, bz, nullptr, nullptr, nullptr, cover);
+    }
   } else if (field) {
     FLOCSIM_LAUNCH(grid, threads, 0, aa_step_kernel<Real, true, false>)
     (s, even, k, bx, by, bz, F[0], F[1], F[2], DeviceCoverage<Real>{});
