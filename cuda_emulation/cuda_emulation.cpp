@@ -45,8 +45,8 @@ namespace {
 
 constexpr std::size_t kDeviceMemory = std::size_t(8) << 30;  // a device's memory
 constexpr std::size_t kSharedWithoutOptIn = 48 * 1024;       // as on every CUDA GPU
-constexpr std::size_t kFiberStack = 256 * 1024;
-constexpr unsigned char kPoison = 0xFF;  // a NaN in every float and double
+constexpr std::size_t kFiberStack = 64 * 1024;               // a kernel's frames take a few KB
+constexpr unsigned char kPoison = 0xFF;                      // a NaN in every float and double
 
 long setting(const char* name, long fallback) {
   const char* text = std::getenv(name);
@@ -66,9 +66,18 @@ long setting(const char* name, long fallback) {
   std::abort();
 }
 
+// What cudaGetLastError returns next: the last error of any call of this
+// host thread (a launch's among them), as CUDA's runtime keeps it.
+thread_local cudaError_t last_error = cudaSuccess;
+
+cudaError_t record(cudaError_t error) {
+  if (error != cudaSuccess) last_error = error;
+  return error;
+}
+
 cudaError_t complain(cudaError_t error, const std::string& what) {
   std::fprintf(stderr, "CUDA emulation: %s (%s)\n", what.c_str(), cudaGetErrorString(error));
-  return error;
+  return record(error);
 }
 
 struct Allocation {
@@ -86,9 +95,9 @@ struct Machine {
   std::map<std::uintptr_t, Allocation> device_memory;  // by start address
   std::vector<std::size_t> used;                       // bytes a device
   std::set<void*> pinned;
-  std::map<const void*, int> max_dynamic_shared;  // per kernel, where raised
-  std::map<const void*, bool> reaches_barrier;    // per kernel, once launched
-  cudaError_t last_error = cudaSuccess;
+  // per device (the machine's index) and kernel, where raised
+  std::map<std::pair<int, const void*>, int> max_dynamic_shared;
+  std::map<const void*, bool> reaches_barrier;  // per kernel, once launched
 
   Machine() {
     const long gpus = setting("FLOCSIM_CUDA_EMULATION_GPUS", 1);
@@ -154,13 +163,15 @@ enum class FiberState { ready, at_barrier, done };
 
 void fiber_entry();
 
-#if defined(__x86_64__)
+// (ELF x86-64 only; with hardware shadow stacks enabled, __CET__ & 2, a
+// `ret` onto another stack would fault: swapcontext knows how there.)
+#if defined(__x86_64__) && defined(__ELF__) && !(defined(__CET__) && (__CET__ & 2))
 // flocsim_emulation_switch(&from_sp, to_sp): pushes the System V callee-saved
 // registers and the MXCSR and x87 control words, stores the stack pointer in
 // from_sp, loads to_sp and pops the same from there.
 extern "C" void flocsim_emulation_switch(void** from_sp, void* to_sp);
 asm(R"(
-  .text
+  .pushsection .text
   .globl flocsim_emulation_switch
   .type flocsim_emulation_switch, @function
 flocsim_emulation_switch:
@@ -186,6 +197,7 @@ flocsim_emulation_switch:
   popq %rbp
   ret
   .size flocsim_emulation_switch, .-flocsim_emulation_switch
+  .popsection
 )");
 
 struct Context {
@@ -270,7 +282,13 @@ void run_block_on_fibers(unsigned threads, dim3 block, bool reverse) {
   while (b.fibers.size() < threads) b.fibers.push_back(std::make_unique<Fiber>());
   for (unsigned t = 0; t < threads; ++t) {
     Fiber& f = *b.fibers[t];
-    if (!f.stack) f.stack.reset(new char[kFiberStack]);
+    if (!f.stack) {
+      // NaN bytes, not the zero pages the system gives: a local read before it
+      // is written must not pass as zero (the kernels are also built with
+      // -ftrivial-auto-var-init=pattern)
+      f.stack.reset(new char[kFiberStack]);
+      std::memset(f.stack.get(), kPoison, kFiberStack);
+    }
     make_context(f.context, f.stack.get(), kFiberStack);
     f.state = FiberState::ready;
   }
@@ -319,7 +337,7 @@ void* dynamic_shared() {
 void launch(const void* kernel, dim3 grid, dim3 block, std::size_t shared_bytes, const Body& body) {
   Machine& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  auto fail = [&](cudaError_t e, const std::string& what) { m.last_error = complain(e, what); };
+  auto fail = [&](cudaError_t e, const std::string& what) { complain(e, what); };
   if (current_device < 0 || current_device >= static_cast<int>(m.visible.size()))
     return fail(cudaErrorNoDevice, "kernel launch without a device");
   const unsigned long threads = static_cast<unsigned long>(block.x) * block.y * block.z;
@@ -337,7 +355,8 @@ void launch(const void* kernel, dim3 grid, dim3 block, std::size_t shared_bytes,
                     " x " + std::to_string(grid.z) +
                     " blocks: each side at least 1, y and z at most 65535");
   if (shared_bytes > kSharedWithoutOptIn) {
-    const auto raised = m.max_dynamic_shared.find(kernel);
+    const auto raised =
+        m.max_dynamic_shared.find({m.visible[static_cast<std::size_t>(current_device)], kernel});
     if (raised == m.max_dynamic_shared.end() ||
         shared_bytes > static_cast<std::size_t>(raised->second))
       return fail(cudaErrorInvalidValue,
@@ -381,7 +400,9 @@ cudaError_t set_max_dynamic_shared(const void* kernel, int bytes) {
     return complain(cudaErrorInvalidValue,
                     "cudaFuncAttributeMaxDynamicSharedMemorySize " + std::to_string(bytes) +
                         ": the device allows at most " + std::to_string(m.shared_optin));
-  m.max_dynamic_shared[kernel] = bytes;
+  if (current_device < 0 || current_device >= static_cast<int>(m.visible.size()))
+    return record(cudaErrorNoDevice);
+  m.max_dynamic_shared[{m.visible[static_cast<std::size_t>(current_device)], kernel}] = bytes;
   return cudaSuccess;
 }
 
@@ -421,15 +442,15 @@ const char* cudaGetErrorString(cudaError_t error) {
 cudaError_t cudaGetLastError() {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  const cudaError_t e = m.last_error;
-  m.last_error = cudaSuccess;
+  const cudaError_t e = flocsim_cuda_emulation::last_error;
+  flocsim_cuda_emulation::last_error = cudaSuccess;
   return e;
 }
 
 cudaError_t cudaPeekAtLastError() {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  return m.last_error;
+  return flocsim_cuda_emulation::last_error;
 }
 
 namespace {
@@ -442,13 +463,13 @@ cudaError_t cudaGetDeviceCount(int* count) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
   *count = static_cast<int>(m.visible.size());
-  return m.visible.empty() ? cudaErrorNoDevice : cudaSuccess;
+  return m.visible.empty() ? flocsim_cuda_emulation::record(cudaErrorNoDevice) : cudaSuccess;
 }
 
 cudaError_t cudaGetDeviceProperties(cudaDeviceProp* prop, int device) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (!valid_device(device)) return cudaErrorInvalidDevice;
+  if (!valid_device(device)) return flocsim_cuda_emulation::record(cudaErrorInvalidDevice);
   *prop = cudaDeviceProp{};
   std::snprintf(prop->name, sizeof prop->name, "CUDA emulation on the CPU (device %d)",
                 m.visible[static_cast<std::size_t>(device)]);
@@ -463,8 +484,8 @@ cudaError_t cudaGetDeviceProperties(cudaDeviceProp* prop, int device) {
 cudaError_t cudaSetDevice(int device) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (m.visible.empty()) return cudaErrorNoDevice;
-  if (!valid_device(device)) return cudaErrorInvalidDevice;
+  if (m.visible.empty()) return flocsim_cuda_emulation::record(cudaErrorNoDevice);
+  if (!valid_device(device)) return flocsim_cuda_emulation::record(cudaErrorInvalidDevice);
   flocsim_cuda_emulation::current_device = device;
   return cudaSuccess;
 }
@@ -472,7 +493,7 @@ cudaError_t cudaSetDevice(int device) {
 cudaError_t cudaGetDevice(int* device) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (m.visible.empty()) return cudaErrorNoDevice;
+  if (m.visible.empty()) return flocsim_cuda_emulation::record(cudaErrorNoDevice);
   *device = flocsim_cuda_emulation::current_device;
   return cudaSuccess;
 }
@@ -480,7 +501,7 @@ cudaError_t cudaGetDevice(int* device) {
 cudaError_t cudaDeviceGetAttribute(int* value, cudaDeviceAttr attr, int device) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (!valid_device(device)) return cudaErrorInvalidDevice;
+  if (!valid_device(device)) return flocsim_cuda_emulation::record(cudaErrorInvalidDevice);
   switch (attr) {
     case cudaDevAttrMultiProcessorCount:
       *value = m.sms;
@@ -489,13 +510,14 @@ cudaError_t cudaDeviceGetAttribute(int* value, cudaDeviceAttr attr, int device) 
       *value = static_cast<int>(m.shared_optin);
       return cudaSuccess;
   }
-  return cudaErrorInvalidValue;
+  return flocsim_cuda_emulation::record(cudaErrorInvalidValue);
 }
 
 cudaError_t cudaMemGetInfo(std::size_t* free, std::size_t* total) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (!valid_device(flocsim_cuda_emulation::current_device)) return cudaErrorNoDevice;
+  if (!valid_device(flocsim_cuda_emulation::current_device))
+    return flocsim_cuda_emulation::record(cudaErrorNoDevice);
   const int d = m.visible[static_cast<std::size_t>(flocsim_cuda_emulation::current_device)];
   *total = flocsim_cuda_emulation::kDeviceMemory;
   *free = *total - m.used[static_cast<std::size_t>(d)];
@@ -509,7 +531,8 @@ cudaError_t cudaDeviceSynchronize() {
 cudaError_t cudaDeviceReset() {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
-  if (!valid_device(flocsim_cuda_emulation::current_device)) return cudaErrorNoDevice;
+  if (!valid_device(flocsim_cuda_emulation::current_device))
+    return flocsim_cuda_emulation::record(cudaErrorNoDevice);
   const int d = m.visible[static_cast<std::size_t>(flocsim_cuda_emulation::current_device)];
   // the device's context goes, and every allocation in it
   for (auto it = m.device_memory.begin(); it != m.device_memory.end();) {
@@ -521,8 +544,9 @@ cudaError_t cudaDeviceReset() {
       ++it;
     }
   }
-  m.max_dynamic_shared.clear();
-  m.last_error = cudaSuccess;
+  for (auto it = m.max_dynamic_shared.begin(); it != m.max_dynamic_shared.end();)
+    it = it->first.first == d ? m.max_dynamic_shared.erase(it) : std::next(it);
+  flocsim_cuda_emulation::last_error = cudaSuccess;
   return cudaSuccess;
 }
 
@@ -530,14 +554,15 @@ cudaError_t cudaMalloc(void** pointer, std::size_t bytes) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
   *pointer = nullptr;
-  if (!valid_device(flocsim_cuda_emulation::current_device)) return cudaErrorNoDevice;
+  if (!valid_device(flocsim_cuda_emulation::current_device))
+    return flocsim_cuda_emulation::record(cudaErrorNoDevice);
   const int d = m.visible[static_cast<std::size_t>(flocsim_cuda_emulation::current_device)];
   if (bytes == 0) return cudaSuccess;
   if (bytes > flocsim_cuda_emulation::kDeviceMemory - m.used[static_cast<std::size_t>(d)])
-    return cudaErrorMemoryAllocation;
+    return flocsim_cuda_emulation::record(cudaErrorMemoryAllocation);
   const std::size_t rounded = (bytes + 255) / 256 * 256;  // cudaMalloc aligns to 256 bytes
   void* p = std::aligned_alloc(256, rounded);
-  if (!p) return cudaErrorMemoryAllocation;
+  if (!p) return flocsim_cuda_emulation::record(cudaErrorMemoryAllocation);
   std::memset(p, flocsim_cuda_emulation::kPoison, rounded);
   m.device_memory[reinterpret_cast<std::uintptr_t>(p)] = {bytes, d};
   m.used[static_cast<std::size_t>(d)] += bytes;
@@ -562,9 +587,9 @@ cudaError_t cudaMallocHost(void** pointer, std::size_t bytes) {
   auto& m = machine();
   std::lock_guard<std::mutex> guard(m.lock);
   *pointer = nullptr;
-  if (m.visible.empty()) return cudaErrorNoDevice;
+  if (m.visible.empty()) return flocsim_cuda_emulation::record(cudaErrorNoDevice);
   void* p = std::aligned_alloc(64, std::max<std::size_t>(64, (bytes + 63) / 64 * 64));
-  if (!p) return cudaErrorMemoryAllocation;
+  if (!p) return flocsim_cuda_emulation::record(cudaErrorMemoryAllocation);
   std::memset(p, flocsim_cuda_emulation::kPoison, bytes);
   m.pinned.insert(p);
   *pointer = p;

@@ -8,18 +8,19 @@
 // block at a time, each of the block's threads a fiber of its own that gives
 // way only at __syncthreads (a legal CUDA schedule). So the GPU tests run here
 // in full: what they check of indexing, launch shapes, barriers, copy sizes
-// and directions, and the order of the sums is checked before any GPU time.
+// and directions and the fixed-order sums is checked before any GPU time.
 // What it cannot show: speed, and the interleavings of real warps (a race
 // between threads with no barrier between them runs in one order here; the
 // emulation can run the threads in reverse, FLOCSIM_CUDA_EMULATION_ORDER=
 // reverse, to see a second).
 //
-// Only what the back-end uses is here. Misuse a GPU would punish is punished
-// here too, with a message on stderr: launch shapes beyond the hardware's
+// Only what the back-end uses is here. Misuse a GPU punishes, or may, is
+// refused here, with a message on stderr: launch shapes beyond the hardware's
 // limits, dynamic shared memory over 48 KB without the kernel's attribute,
 // copies that fall outside a device allocation or go the wrong way, a barrier
-// that only some of a block's threads reach. Fresh device and shared memory
-// is filled with NaN bytes (a GPU's is not zeroed either).
+// that only some of a block's threads reach. Fresh device, pinned and dynamic
+// shared memory, and the fibers' stacks, are filled with NaN bytes (a GPU's
+// are not zeroed either); static __shared__ arrays are not (docs/gpu.md).
 #include <cstddef>
 #include <cstring>
 #include <functional>
@@ -64,9 +65,9 @@ using Body = std::function<void()>;
 // cudaGetLastError, as a failed launch leaves it.
 void launch(const void* kernel, dim3 grid, dim3 block, std::size_t shared_bytes, const Body& body);
 
-// kernel<<<grid, block, shared>>>(args...): the arguments are copied once,
-// as a launch copies them to the GPU, and every thread calls the kernel on
-// that copy.
+// kernel<<<grid, block, shared>>>(args...): the arguments are converted to
+// the kernel's parameters once, and each thread gets its own copy of them (its
+// parameters by value), as on a GPU.
 template <class... Params>
 struct Launcher {
   void (*kernel)(Params...);

@@ -1,8 +1,9 @@
 // The CPU emulation of CUDA (cuda_emulation/) keeps the CUDA semantics the
 // back-end's launchers rely on (every thread of a block past a barrier before
 // any goes on; shared memory one per block; the launch's index space), and
-// refuses what a GPU would punish, as a GPU does: by an error code, or for a
-// barrier only part of a block reaches, by stopping.
+// refuses what a GPU would punish, as a GPU does: by an error code (kept for
+// cudaGetLastError), or for a barrier only part of a block reaches, by
+// stopping.
 #include <cuda_runtime.h>
 #include <gtest/gtest.h>
 
@@ -126,6 +127,7 @@ TEST(CudaEmulation, DynamicSharedMemoryOver48KbNeedsTheKernelsAttribute) {
   EXPECT_EQ(cudaFuncSetAttribute(shared_fill_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                  optin + 1),
             cudaErrorInvalidValue);
+  EXPECT_EQ(cudaGetLastError(), cudaErrorInvalidValue) << "the refused attribute's error, kept";
   ASSERT_EQ(cudaFuncSetAttribute(shared_fill_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                  static_cast<int>(bytes)),
             cudaSuccess);
@@ -144,6 +146,8 @@ TEST(CudaEmulation, CopiesOutsideAnAllocationOrTheWrongWayAreRefused) {
   EXPECT_EQ(cudaMemcpy(d, h.data(), sizeof(double) * 11, cudaMemcpyHostToDevice),
             cudaErrorInvalidValue)
       << "past the end of the allocation";
+  EXPECT_EQ(cudaGetLastError(), cudaErrorInvalidValue) << "a failed call leaves its error";
+  EXPECT_EQ(cudaGetLastError(), cudaSuccess) << "and cudaGetLastError clears it";
   EXPECT_EQ(cudaMemcpy(h.data(), d, sizeof(double) * 10, cudaMemcpyHostToDevice),
             cudaErrorInvalidValue)
       << "source and destination swapped";
