@@ -64,5 +64,32 @@ TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
   EXPECT_GE(checked, 10);
 }
 
+// A point that was refused up front keeps its case.json and refused.txt (the
+// refusal is the result: docs/accuracy-cost.md, "The grid's corners"). This
+// version must still refuse it, with the message the record quotes, so a
+// changed floor or remedy cannot leave a stale record behind.
+TEST(CommittedValidationCases, RefusedPointsStillMeetTheRefusalTheirRecordQuotes) {
+  const fs::path root = FLOCSIM_SOURCE_DIR;
+  int checked = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(root / "docs" / "validation")) {
+    if (entry.path().filename() != "refused.txt") continue;
+    const fs::path case_file = entry.path().parent_path() / "case.json";
+    SCOPED_TRACE(fs::relative(entry.path(), root).string());
+    ASSERT_TRUE(fs::exists(case_file));
+    std::ifstream in(entry.path());
+    const std::string record((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+    try {
+      cases::parse_suspension_case(read_json(case_file));
+      ADD_FAILURE() << "accepted, but refused.txt records a refusal";
+    } catch (const input::InputError& e) {
+      EXPECT_NE(record.find(e.what()), std::string::npos)
+          << "refused now with: " << e.what() << "\nrecorded: " << record;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 8);  // the draft and paper presets' four Re_inf 72 corners each
+}
+
 }  // namespace
 }  // namespace flocsim
