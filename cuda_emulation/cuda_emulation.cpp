@@ -17,6 +17,10 @@
 //                                         of blocks, and of threads between barriers
 //   FLOCSIM_CUDA_EMULATION_FIBERS         always: every launch on fibers
 // CUDA_VISIBLE_DEVICES selects among the devices as CUDA's does.
+//
+// In this file, in order: the settings and the last error; the machine (its
+// devices, their memory, the kernels' attributes); the fibers and the switch
+// between them; a launch; then the runtime's calls, each checked as CUDA's.
 #include <ucontext.h>
 
 #include <algorithm>
@@ -46,7 +50,8 @@ namespace {
 constexpr std::size_t kDeviceMemory = std::size_t(8) << 30;  // a device's memory
 constexpr std::size_t kSharedWithoutOptIn = 48 * 1024;       // as on every CUDA GPU
 constexpr std::size_t kFiberStack = 64 * 1024;               // a kernel's frames take a few KB
-constexpr unsigned char kPoison = 0xFF;                      // a NaN in every float and double
+constexpr std::size_t kStackGuard = 4096;  // lowest bytes of a fiber stack, never to be written
+constexpr unsigned char kPoison = 0xFF;    // a NaN in every float and double
 
 long setting(const char* name, long fallback) {
   const char* text = std::getenv(name);
@@ -315,6 +320,21 @@ void run_block_on_fibers(unsigned threads, dim3 block, bool reverse) {
   }
 }
 
+// The fiber stacks have no guard page: a kernel whose frames outgrow
+// kFiberStack would write into the heap below. Their lowest kStackGuard bytes
+// keep the poison they were filled with unless that happened, so a launch that
+// ran on fibers checks them once at its end (the blocks reuse the fibers).
+void check_stack_guards(unsigned threads) {
+  for (unsigned t = 0; t < threads; ++t) {
+    const char* low = block_state.fibers[t]->stack.get();
+    for (std::size_t i = 0; i < kStackGuard; ++i)
+      if (static_cast<unsigned char>(low[i]) != kPoison)
+        fatal("thread " + std::to_string(t) + "'s stack overflowed its " +
+              std::to_string(kFiberStack / 1024) +
+              " KB (the kernel's locals are larger than any here so far; raise kFiberStack)");
+  }
+}
+
 }  // namespace
 
 void sync_threads() {
@@ -388,6 +408,7 @@ void launch(const void* kernel, dim3 grid, dim3 block, std::size_t shared_bytes,
       run_block_on_fibers(static_cast<unsigned>(threads), block, m.reverse);
     }
   }
+  if (!b.direct) check_stack_guards(static_cast<unsigned>(threads));
   if (known == m.reaches_barrier.end()) m.reaches_barrier[kernel] = b.barrier_seen;
   b.direct = false;
   b.body = nullptr;

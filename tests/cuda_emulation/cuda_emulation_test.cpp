@@ -190,4 +190,21 @@ TEST(CudaEmulationDeathTest, ABarrierOnlyPartOfABlockReachesStops) {
   cudaFree(d);
 }
 
+// Locals of 62 KB: more than the emulation's 64 KB fiber stacks leave once the
+// frames above the kernel are in, so they reach the stack's lowest 4 KB, which
+// no kernel may touch (the stacks have no guard page; the heap lies below).
+__global__ void large_locals_kernel(int* out) {
+  volatile unsigned char locals[62 * 1024];
+  for (std::size_t i = 0; i < sizeof locals; ++i) locals[i] = 1;
+  __syncthreads();
+  out[threadIdx.x] = locals[threadIdx.x];
+}
+
+TEST(CudaEmulationDeathTest, AKernelWhoseLocalsOutgrowItsStackStops) {
+  int* d = nullptr;
+  ASSERT_EQ(cudaMalloc(&d, sizeof(int) * 2), cudaSuccess);
+  EXPECT_DEATH(FLOCSIM_LAUNCH(1, 2, 0, large_locals_kernel)(d), "stack overflowed");
+  cudaFree(d);
+}
+
 }  // namespace
