@@ -1,48 +1,100 @@
 #!/usr/bin/env python3
-"""The two tables of an accuracy trade (docs/accuracy-cost.md, "The grid's corners"): runs of one
-case at two or more U_inf, several seeds each, committed as FOLDER/U<U_inf>-seed<seed>/result.json.
+"""The tables of an accuracy trade (docs/accuracy-cost.md, "The grid's corners"): runs of one case
+at two or more U_inf, the same seeds at each.
 
-First table, one row per run: F, U/U_inf, C_sph, <n_a>, Re_T with the batch-means error each
-result.json gives, the largest liquid speed in U_inf and its Mach number, the coupling monitor's
-worst window, and the steps and wall time.
+SOURCE is either a folder holding each run as U<U_inf>-seed<seed>/result.json, or a runs.csv
+with one row per run (columns U_inf, seed, F, F_err, U_over_Uinf, U_over_Uinf_err, C_sph,
+C_sph_err, n_a_mean, n_a_mean_err, Re_T, Re_T_err, max_liquid_speed_over_U_inf,
+max_liquid_Mach, coupling_worst_window, mass_balance_rel, momentum_balance_rel, steps, wall_s).
 
-Second table, one row per U_inf: the mean over its seeds; the error of the mean is the larger of
-the seeds' scatter (sample standard deviation over sqrt(seeds)) and the runs' combined batch
-errors (root of the sum of squares over the number of seeds). Then the first U_inf (the preset's,
-the largest) against each other: the relative difference a/b - 1, its error (the ratio's: a/b
-times the two relative errors in quadrature), and in brackets the difference in those errors.
-The tables of the standard trade in docs/accuracy-cost.md are what this prints for its folder.
+First table, one row per run: F, U/U_inf, C_sph, <n_a>, Re_T with the batch-means error each run
+gives, the largest liquid speed in U_inf and its Mach number, and the coupling monitor's worst
+window.
 
-Usage: scripts/trade-table.py FOLDER
-       scripts/trade-table.py --check DOC FOLDER   fails unless DOC holds every table row verbatim"""
-import json, math, pathlib, re, statistics, sys
+Second table, one row per U_inf: the mean over its seeds, whose error is the larger of the seeds'
+scatter (sample standard deviation over sqrt(seeds)) and the runs' combined batch errors (root of
+the sum of their squares over the number of seeds). Then the reference U_inf (the largest, the
+preset's, unless --reference names another) against each other: the relative difference
+a/b - 1, its error (the ratio's: a/b times the two relative errors in quadrature), and in
+brackets the difference in those errors. Below: the balances and each run's steps and wall time.
 
-# (label, observables key, decimals in a run's row, decimals in a mean's row)
+--check DOC fails unless DOC holds each table as one whole table, row for row (for a runs.csv,
+whose per-run figures stay in the file, the second table only). The trades' tables in
+docs/accuracy-cost.md are what this prints; the test DocTradeTableMatchesItsRuns holds them so.
+
+Usage: scripts/trade-table.py [--reference U_INF] [--check DOC] SOURCE"""
+import argparse, csv, json, math, pathlib, re, statistics, sys
+
+# (label, key in result.json's observables and in runs.csv, decimals in a run's row, in a mean's)
 FIGURES = [('F', 'F', 2, 2), ('U/U_inf', 'U_over_Uinf', 3, 3), ('C_sph', 'C_sph', 2, 2),
            ('<n_a>', 'n_a_mean', 1, 1), ('Re_T', 'Re_T', 1, 2)]
 
 
-def load(folder):
+def fail(message):
+    sys.exit(f"trade-table.py: {message}")
+
+
+def run_from_result(path, U_inf, seed):
+    r = json.load(open(path))
+    if r.get('status') != 'completed':
+        fail(f"{path}: status {r.get('status')!r}: no table from a run that did not complete")
+    if not math.isclose(r['derived']['U_inf'], U_inf, rel_tol=1e-9) or r['case']['seed'] != seed:
+        fail(f"{path}: the run has U_inf {r['derived']['U_inf']:g} and seed {r['case']['seed']}, "
+             f"its folder says {U_inf:g} and {seed}")
+    o, cost = r['observables'], r['cost']
+    return {'figures': {key: (o[key]['mean'], o[key]['error']) for _, key, _, _ in FIGURES},
+            'speed_over_U_inf': o['max_liquid_speed'] / U_inf, 'Mach': o['max_liquid_Mach'],
+            'monitor': o['coupling_oscillation']['worst_window'],
+            'mass': o['mass_balance']['relative_to_liquid_mass'],
+            'momentum': o['momentum_balance']['relative_to_sphere_momentum'],
+            'overlap': o['events']['worst_overlap'], 'steps': cost['steps'], 'wall_s': cost['wall_s']}
+
+
+def run_from_csv(row):
+    number = lambda key: float(row[key])
+    return {'figures': {key: (number(key), number(key + '_err')) for _, key, _, _ in FIGURES},
+            'speed_over_U_inf': number('max_liquid_speed_over_U_inf'), 'Mach': number('max_liquid_Mach'),
+            'monitor': number('coupling_worst_window'), 'mass': number('mass_balance_rel'),
+            'momentum': number('momentum_balance_rel'), 'overlap': None,
+            'steps': int(row['steps']), 'wall_s': number('wall_s')}
+
+
+def load(source):
+    """{U_inf: {seed: run}}, every figure finite and the same seeds at every U_inf."""
     runs = {}
-    for path in sorted(pathlib.Path(folder).glob('U*-seed*/result.json')):
-        match = re.fullmatch(r'U([0-9.]+)-seed([0-9]+)', path.parent.name)
-        if not match:
-            continue
-        r = json.load(open(path))
-        if r.get('status') != 'completed':
-            sys.exit(f"{path}: status {r.get('status')!r}, not completed: no table from a run that did not finish")
-        runs.setdefault(float(match.group(1)), {})[int(match.group(2))] = r
+    path = pathlib.Path(source)
+    if path.is_dir():
+        for folder in sorted(path.glob('U*-seed*')):
+            match = re.fullmatch(r'U([0-9.]+)-seed([0-9]+)', folder.name)
+            if not match:
+                continue
+            if not (folder / 'result.json').is_file():
+                fail(f"{folder}: no result.json")
+            U_inf, seed = float(match.group(1)), int(match.group(2))
+            runs.setdefault(U_inf, {})[seed] = run_from_result(folder / 'result.json', U_inf, seed)
+    elif path.is_file():
+        for row in csv.DictReader(open(path)):
+            runs.setdefault(float(row['U_inf']), {})[int(row['seed'])] = run_from_csv(row)
+    else:
+        fail(f"{source}: neither a folder of runs nor a runs.csv")
     if len(runs) < 2:
-        sys.exit(f"{folder}: needs runs at two U_inf at least (found {sorted(runs)})")
+        fail(f"{source}: a trade needs runs at two U_inf at least, found {sorted(runs)}")
+    seed_sets = {U_inf: sorted(seeds) for U_inf, seeds in runs.items()}
+    if len(set(map(tuple, seed_sets.values()))) != 1:
+        fail(f"{source}: the seeds differ between U_inf ({seed_sets}): the means would not compare")
+    for U_inf, seeds in runs.items():
+        for seed, run in seeds.items():
+            for key, (mean, error) in run['figures'].items():
+                if not (math.isfinite(mean) and math.isfinite(error)):
+                    fail(f"{source}: U_inf {U_inf:g} seed {seed}: {key} is {mean} +- {error}")
     return dict(sorted(runs.items(), reverse=True))
 
 
 def mean_and_error(values, errors):
     n = len(values)
-    mean = sum(values) / n
     combined = math.sqrt(sum(e * e for e in errors)) / n
     scatter = statistics.stdev(values) / math.sqrt(n) if n > 1 else 0.0
-    return mean, max(scatter, combined)
+    return sum(values) / n, max(scatter, combined)
 
 
 def short_exponent(value):
@@ -50,69 +102,95 @@ def short_exponent(value):
     return '0' if value == 0 else f"{value:.1e}".replace('e-0', 'e-').replace('e+0', 'e+')
 
 
-def percent(difference, error):
-    """A difference and its error in per cent, to the error's precision: one decimal below 10 %."""
+def difference_cell(a, error_a, b, error_b):
+    """a against b in per cent, with the ratio's error, to that error's precision (one decimal below
+    10 %), and the difference in errors."""
+    if a == 0 or b == 0:
+        return f"{a:g} against {b:g}"
+    difference = a / b - 1
+    error = (a / b) * math.hypot(error_a / a, error_b / b)
     digits = 0 if 100 * error >= 10 else 1
-    return f"{100 * difference:+.{digits}f} % +- {100 * error:.{digits}f} % ({abs(difference) / error:.1f})"
+    text = f"{100 * difference:+.{digits}f} % +- {100 * error:.{digits}f} %"
+    return text + (f" ({abs(difference) / error:.1f})" if error > 0 else " (exact)")
 
 
-def tables(runs):
-    """The lines of both tables and the balances below them."""
+def per_run_table(runs):
     lines = ['| U_inf, seed | ' + ' | '.join(f[0] for f in FIGURES) +
              ' | largest liquid speed (U_inf); Mach | coupling monitor, worst window |',
              '|---' * (len(FIGURES) + 3) + '|']
     for U_inf, seeds in runs.items():
-        for seed, r in sorted(seeds.items()):
-            o = r['observables']
-            cells = [f"{o[key]['mean']:.{digits}f} +- {o[key]['error']:.{digits}f}" for _, key, digits, _ in FIGURES]
+        for seed, run in sorted(seeds.items()):
+            cells = [f"{run['figures'][key][0]:.{digits}f} +- {run['figures'][key][1]:.{digits}f}"
+                     for _, key, digits, _ in FIGURES]
             lines.append(f"| {U_inf:g}, {seed} | " + ' | '.join(cells) +
-                         f" | {o['max_liquid_speed'] / U_inf:.2f}; {o['max_liquid_Mach']:.3f}"
-                         f" | {short_exponent(o['coupling_oscillation']['worst_window'])} |")
-    lines.append('')
+                         f" | {run['speed_over_U_inf']:.2f}; {run['Mach']:.3f} | {short_exponent(run['monitor'])} |")
+    return lines
 
-    means = {}
-    for U_inf, seeds in runs.items():
-        means[U_inf] = {key: mean_and_error([r['observables'][key]['mean'] for r in seeds.values()],
-                                            [r['observables'][key]['error'] for r in seeds.values()])
-                        for _, key, _, _ in FIGURES}
-    lines += ['| | ' + ' | '.join(f[0] for f in FIGURES) + ' |', '|---' * (len(FIGURES) + 1) + '|']
+
+def means_table(runs, reference):
+    means = {U_inf: {key: mean_and_error([run['figures'][key][0] for run in seeds.values()],
+                                         [run['figures'][key][1] for run in seeds.values()])
+                     for _, key, _, _ in FIGURES}
+             for U_inf, seeds in runs.items()}
+    lines = ['| | ' + ' | '.join(f[0] for f in FIGURES) + ' |', '|---' * (len(FIGURES) + 1) + '|']
     for U_inf, m in means.items():
         lines.append(f"| U_inf {U_inf:g} | " +
                      ' | '.join(f"{m[key][0]:.{digits}f} +- {m[key][1]:.{digits}f}" for _, key, _, digits in FIGURES) +
                      ' |')
-    first = next(iter(means))
-    for U_inf in list(means)[1:]:
-        cells = []
-        for _, key, _, _ in FIGURES:
-            (a, ea), (b, eb) = means[first][key], means[U_inf][key]
-            cells.append(percent(a / b - 1, (a / b) * math.hypot(ea / a, eb / b)))  # the ratio's error
-        lines.append(f"| {first:g} against {U_inf:g} | " + ' | '.join(cells) + ' |')
-
-    every = [r for seeds in runs.values() for r in seeds.values()]
-    lines.append('')
-    lines.append(f"over every run: mass to {max(r['observables']['mass_balance']['relative_to_liquid_mass'] for r in every):.1e}"
-                 f" of the liquid's, momentum to "
-                 f"{max(r['observables']['momentum_balance']['relative_to_sphere_momentum'] for r in every):.1e} of the"
-                 f" spheres', worst overlap {max(r['observables']['events']['worst_overlap'] for r in every):g}; steps and"
-                 f" wall time: " + ', '.join(f"{r['case']['numerics']['U_inf'] if 'U_inf' in r['case']['numerics'] else r['derived']['U_inf']:g}"
-                                             f" seed {r['case']['seed']} {r['cost']['steps']} in {r['cost']['wall_s'] / 60:.1f} min"
-                                             for r in every))
+    for U_inf in (U for U in means if U != reference):
+        cells = [difference_cell(*means[reference][key], *means[U_inf][key]) for _, key, _, _ in FIGURES]
+        lines.append(f"| {reference:g} against {U_inf:g} | " + ' | '.join(cells) + ' |')
     return lines
 
 
-def main(argv):
-    if len(argv) == 4 and argv[1] == '--check':
-        doc_lines = set(line.rstrip() for line in open(argv[2]))
-        missing = [line for line in tables(load(argv[3])) if line.startswith('|') and line not in doc_lines]
-        if missing:
-            sys.exit(f"{argv[2]} does not hold these rows of the trade in {argv[3]}, as its result.json files give them:\n" +
-                     '\n'.join(missing))
-        print(f"{argv[2]} holds every row of the trade in {argv[3]}")
+def footer(runs):
+    every = [(U_inf, seed, run) for U_inf, seeds in runs.items() for seed, run in sorted(seeds.items())]
+    overlaps = [run['overlap'] for _, _, run in every if run['overlap'] is not None]
+    return (f"over every run: mass to {max(run['mass'] for _, _, run in every):.1e} of the liquid's, momentum to "
+            f"{max(run['momentum'] for _, _, run in every):.1e} of the spheres'" +
+            (f", worst overlap {max(overlaps):g}" if overlaps else '') + "; steps and wall time: " +
+            ', '.join(f"{U_inf:g} seed {seed} {run['steps']} in {run['wall_s'] / 60:.1f} min" for U_inf, seed, run in every))
+
+
+def find_table(doc_lines, block):
+    """Whether block stands in doc_lines as one whole table: its rows in order, no row before or after."""
+    for i in range(len(doc_lines) - len(block) + 1):
+        if doc_lines[i:i + len(block)] == block:
+            before = doc_lines[i - 1] if i > 0 else ''
+            after = doc_lines[i + len(block)] if i + len(block) < len(doc_lines) else ''
+            if not before.startswith('|') and not after.startswith('|'):
+                return True
+    return False
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--reference', type=float, help='the U_inf the others are compared with (default: the largest)')
+    parser.add_argument('--check', metavar='DOC', help='fail unless DOC holds the tables, row for row')
+    parser.add_argument('source', metavar='SOURCE')
+    args = parser.parse_args()
+    runs = load(args.source)
+    reference = max(runs) if args.reference is None else args.reference
+    if reference not in runs:
+        fail(f"--reference {reference:g}: no runs at that U_inf (there are {sorted(runs)})")
+
+    blocks = [means_table(runs, reference)]
+    if pathlib.Path(args.source).is_dir():
+        blocks.insert(0, per_run_table(runs))
+    if args.check:
+        doc_lines = [line.rstrip() for line in open(args.check)]
+        for block in blocks:
+            if not find_table(doc_lines, block):
+                missing = [row for row in block if row not in doc_lines]
+                fail(f"{args.check} does not hold this table of the trade in {args.source} as its runs give it" +
+                     (", these rows differ or are missing:\n" + '\n'.join(missing) if missing else
+                      " as one whole table (every row is there, but not in order, or with other rows beside them):\n" +
+                      '\n'.join(block)))
+        print(f"{args.check} holds the tables of the trade in {args.source}")
         return
-    if len(argv) != 2:
-        sys.exit(__doc__)
-    print('\n'.join(tables(load(argv[1]))))
+    print('\n\n'.join('\n'.join(block) for block in blocks))
+    print('\n' + footer(runs))
 
 
 if __name__ == '__main__':
-    main(sys.argv)
+    main()
