@@ -16,7 +16,7 @@ scatter (sample standard deviation over sqrt(seeds)) and the runs' combined batc
 the sum of their squares over the number of seeds). Then the reference U_inf (the largest, the
 preset's, unless --reference names another) against each other: the relative difference
 a/b - 1, its error (the ratio's: a/b times the two relative errors in quadrature), and in
-brackets the difference in those errors. Below: the balances and each run's steps and wall time.
+brackets |a/b - 1| in units of that error. Below: the balances and each run's steps and wall time.
 
 --check DOC fails unless DOC holds each table as one whole table, row for row (for a runs.csv,
 whose per-run figures stay in the file, the second table only). The trades' tables in
@@ -35,6 +35,13 @@ def fail(message):
 
 
 def run_from_result(path, U_inf, seed):
+    try:
+        return checked_run_from_result(path, U_inf, seed)
+    except (KeyError, TypeError, ValueError) as e:
+        fail(f"{path}: not a flocsim result.json with every figure a trade needs ({type(e).__name__}: {e})")
+
+
+def checked_run_from_result(path, U_inf, seed):
     r = json.load(open(path))
     if r.get('status') != 'completed':
         fail(f"{path}: status {r.get('status')!r}: no table from a run that did not complete")
@@ -50,31 +57,49 @@ def run_from_result(path, U_inf, seed):
             'overlap': o['events']['worst_overlap'], 'steps': cost['steps'], 'wall_s': cost['wall_s']}
 
 
-def run_from_csv(row):
-    number = lambda key: float(row[key])
+def run_from_csv(row, where):
+    def number(key):
+        if key not in row:
+            fail(f"{where}: no column {key}")
+        try:
+            return float(row[key])
+        except (TypeError, ValueError):
+            fail(f"{where}: column {key} is {row[key]!r}, not a number")
     return {'figures': {key: (number(key), number(key + '_err')) for _, key, _, _ in FIGURES},
             'speed_over_U_inf': number('max_liquid_speed_over_U_inf'), 'Mach': number('max_liquid_Mach'),
             'monitor': number('coupling_worst_window'), 'mass': number('mass_balance_rel'),
             'momentum': number('momentum_balance_rel'), 'overlap': None,
-            'steps': int(row['steps']), 'wall_s': number('wall_s')}
+            'steps': int(number('steps')), 'wall_s': number('wall_s')}
 
 
 def load(source):
     """{U_inf: {seed: run}}, every figure finite and the same seeds at every U_inf."""
     runs = {}
+
+    def add(U_inf, seed, run, where):
+        if seed in runs.setdefault(U_inf, {}):
+            fail(f"{where}: a second run at U_inf {U_inf:g}, seed {seed}: which one the table means is not clear")
+        runs[U_inf][seed] = run
+
     path = pathlib.Path(source)
     if path.is_dir():
         for folder in sorted(path.glob('U*-seed*')):
             match = re.fullmatch(r'U([0-9.]+)-seed([0-9]+)', folder.name)
             if not match:
-                continue
+                fail(f"{folder}: not named U<U_inf>-seed<seed>; rename it or move it out of {source}")
             if not (folder / 'result.json').is_file():
                 fail(f"{folder}: no result.json")
             U_inf, seed = float(match.group(1)), int(match.group(2))
-            runs.setdefault(U_inf, {})[seed] = run_from_result(folder / 'result.json', U_inf, seed)
+            add(U_inf, seed, run_from_result(folder / 'result.json', U_inf, seed), folder)
     elif path.is_file():
-        for row in csv.DictReader(open(path)):
-            runs.setdefault(float(row['U_inf']), {})[int(row['seed'])] = run_from_csv(row)
+        for line, row in enumerate(csv.DictReader(open(path)), start=2):
+            where = f"{source}, line {line}"
+            run = run_from_csv(row, where)
+            try:
+                U_inf, seed = float(row['U_inf']), int(row['seed'])
+            except (KeyError, TypeError, ValueError):
+                fail(f"{where}: U_inf {row.get('U_inf')!r} and seed {row.get('seed')!r} must be a number and an integer")
+            add(U_inf, seed, run, where)
     else:
         fail(f"{source}: neither a folder of runs nor a runs.csv")
     if len(runs) < 2:
@@ -183,7 +208,7 @@ def main():
             if not find_table(doc_lines, block):
                 missing = [row for row in block if row not in doc_lines]
                 fail(f"{args.check} does not hold this table of the trade in {args.source} as its runs give it" +
-                     (", these rows differ or are missing:\n" + '\n'.join(missing) if missing else
+                     (f"; {args.check} lacks these rows, as the runs give them:\n" + '\n'.join(missing) if missing else
                       " as one whole table (every row is there, but not in order, or with other rows beside them):\n" +
                       '\n'.join(block)))
         print(f"{args.check} holds the tables of the trade in {args.source}")
