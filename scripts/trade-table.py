@@ -35,26 +35,22 @@ def fail(message):
 
 
 def run_from_result(path, U_inf, seed):
-    try:
-        return checked_run_from_result(path, U_inf, seed)
-    except (KeyError, TypeError, ValueError) as e:
-        fail(f"{path}: not a flocsim result.json with every figure a trade needs ({type(e).__name__}: {e})")
-
-
-def checked_run_from_result(path, U_inf, seed):
     r = json.load(open(path))
     if r.get('status') != 'completed':
         fail(f"{path}: status {r.get('status')!r}: no table from a run that did not complete")
-    if not math.isclose(r['derived']['U_inf'], U_inf, rel_tol=1e-9) or r['case']['seed'] != seed:
-        fail(f"{path}: the run has U_inf {r['derived']['U_inf']:g} and seed {r['case']['seed']}, "
-             f"its folder says {U_inf:g} and {seed}")
-    o, cost = r['observables'], r['cost']
-    return {'figures': {key: (o[key]['mean'], o[key]['error']) for _, key, _, _ in FIGURES},
-            'speed_over_U_inf': o['max_liquid_speed'] / U_inf, 'Mach': o['max_liquid_Mach'],
-            'monitor': o['coupling_oscillation']['worst_window'],
-            'mass': o['mass_balance']['relative_to_liquid_mass'],
-            'momentum': o['momentum_balance']['relative_to_sphere_momentum'],
-            'overlap': o['events']['worst_overlap'], 'steps': cost['steps'], 'wall_s': cost['wall_s']}
+    try:
+        if not math.isclose(r['derived']['U_inf'], U_inf, rel_tol=1e-9) or r['case']['seed'] != seed:
+            fail(f"{path}: the run has U_inf {r['derived']['U_inf']:g} and seed {r['case']['seed']}, "
+                 f"its folder says {U_inf:g} and {seed}")
+        o, cost = r['observables'], r['cost']
+        return {'figures': {key: (o[key]['mean'], o[key]['error']) for _, key, _, _ in FIGURES},
+                'speed_over_U_inf': o['max_liquid_speed'] / U_inf, 'Mach': o['max_liquid_Mach'],
+                'monitor': o['coupling_oscillation']['worst_window'],
+                'mass': o['mass_balance']['relative_to_liquid_mass'],
+                'momentum': o['momentum_balance']['relative_to_sphere_momentum'],
+                'overlap': o['events']['worst_overlap'], 'steps': cost['steps'], 'wall_s': cost['wall_s']}
+    except (KeyError, TypeError) as e:
+        fail(f"{path}: not a flocsim result.json with every figure a trade needs ({type(e).__name__}: {e})")
 
 
 def run_from_csv(row, where):
