@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""One row of the grid's-corners table (docs/accuracy-cost.md, "The grid's corners") from a corner
+"""One row of the grid's-corners table (docs/corners.md) from a corner
 run's result.json: outcome and steps, largest liquid speed in lattice units and in U_inf, its Mach
 number, largest sphere speed, worst overlap, mass and momentum balance, the coupling monitor's worst
 window, U/U_inf, F and C_sph with their batch-means errors, and the wall time; on stderr the case's

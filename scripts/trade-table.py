@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The tables of an accuracy trade (docs/accuracy-cost.md, "The grid's corners"): runs of one case
+"""The tables of an accuracy trade (docs/corners.md): runs of one case
 at two or more U_inf, the same seeds at each.
 
 SOURCE is either a folder holding each run as U<U_inf>-seed<seed>/result.json, or a runs.csv
@@ -20,7 +20,7 @@ brackets |a/b - 1| in units of that error. Below: the balances and each run's st
 
 --check DOC fails unless DOC holds each table as one whole table, row for row (for a runs.csv,
 whose per-run figures stay in the file, the second table only). The trades' tables in
-docs/accuracy-cost.md are what this prints; the test DocTradeTableMatchesItsRuns holds them so.
+docs/corners.md are what this prints; the test DocTradeTableMatchesItsRuns holds them so.
 
 Usage: scripts/trade-table.py [--reference U_INF] [--check DOC] SOURCE"""
 import argparse, csv, json, math, pathlib, re, statistics, sys

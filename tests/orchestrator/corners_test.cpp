@@ -1,8 +1,8 @@
 // The paper's grid at its corners (sweeps/corners*.json: phi 0.12/0.32 x
 // Re_inf 6/72 x du/U_inf 0/0.03, and phi 0.12, Re_inf 6, du 0.05), one file
 // per fidelity preset: `flocsim sweep plan` (sizes only, nothing timed or
-// stepped) refuses at each preset exactly the corners that docs/accuracy-cost.md
-// ("The grid's corners") says it cannot run, with the run's own message naming
+// stepped) refuses at each preset exactly the corners that docs/corners.md
+// says it cannot run, with the run's own message naming
 // what would work, and accepts the rest.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -48,7 +48,7 @@ TEST(GridCorners, EachPresetRefusesExactlyTheCornersItCannotRun) {
   // 0.0067; the floor would need U_inf 0.08) and runs phi 0.12 there with one
   // sweep. paper takes the paper's method everywhere: it refuses all four
   // Re_inf 72 corners. At Re_inf 6 every preset's nu (0.093, 0.08, 0.04) is far
-  // above both floors, and the corners ran there (docs/accuracy-cost.md).
+  // above both floors, and the corners ran there (docs/corners.md).
   const std::set<Corner> grid = {{0.12, 6, 0},     {0.12, 6, 0.03},  {0.12, 72, 0},
                                  {0.12, 72, 0.03}, {0.32, 6, 0},     {0.32, 6, 0.03},
                                  {0.32, 72, 0},    {0.32, 72, 0.03}, {0.12, 6, 0.05}};

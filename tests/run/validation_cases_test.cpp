@@ -65,7 +65,7 @@ TEST(CommittedValidationCases, ResolveToTheCaseTheirResultRan) {
 }
 
 // A point that was refused up front keeps its case.json and refused.txt (the
-// refusal is the result: docs/accuracy-cost.md, "The grid's corners"). This
+// refusal is the result: docs/corners.md). This
 // version must still refuse it, with the message the record quotes, so a
 // changed floor or remedy cannot leave a stale record behind.
 TEST(CommittedValidationCases, RefusedPointsStillMeetTheRefusalTheirRecordQuotes) {
