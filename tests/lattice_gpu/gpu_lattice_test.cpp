@@ -219,6 +219,9 @@ TEST(GpuRun, FluidSceneRunsOnTheGpuAndRecordsIt) {
   const std::string command = std::string(exe) + " run " + source +
                               "/examples/fluid_shear_wave.json --out " + out.string() +
                               " --device cuda --quiet";
+  // This process holds a context on the GPU (query_gpus, the tests before):
+  // in an exclusive compute mode the child would find the GPU taken.
+  flocsim::gpu::release_gpus();
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "result.json");
   const auto result = nlohmann::json::parse(in);
@@ -242,6 +245,7 @@ TEST(GpuRun, AGpuCheckpointResumesOnTheCpu) {
   const fs::path base =
       fs::temp_directory_path() / ("flocsim-gpu-resume-" + std::to_string(getpid()));
   fs::remove_all(base);
+  flocsim::gpu::release_gpus();  // the child's GPU, in an exclusive mode (above)
   const auto run = [&](const fs::path& out, const std::string& extra) {
     return std::system(
         (std::string(exe) + " run " + example + " --out " + out.string() + " --quiet " + extra)
