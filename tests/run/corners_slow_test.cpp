@@ -50,7 +50,8 @@ TEST(GridCornersSlow, DraftCornersRunWithoutBlowUpOrOscillation) {
       // The measured range ends near Mach 0.3: the Mach study (phi 0.2) held the
       // drag to 1.2 % with flows up to Mach 0.25, and the draft trade at phi 0.12,
       // du 0.03 found U_inf 0.07 and 0.035 agreeing with flows up to 0.28
-      // (docs/corners.md). A corner that goes faster has left that range.
+      // (docs/accuracy-cost.md, "The lattice Mach number", and docs/corners.md). A
+      // corner that goes faster has left that range.
       EXPECT_LT(obs["max_liquid_Mach"].get<double>(), 0.3) << what;
       EXPECT_LT(obs["max_sphere_speed"].get<double>(), 0.3) << what;  // the blow-up check
       // the events keep hard spheres apart exactly: any overlap is a missed collision
