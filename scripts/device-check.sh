@@ -12,8 +12,9 @@
 # Time limits per step: 50 + 55 + 85 + 80 + 40 + 4 x 25 + 2 x 35 = 480 s at
 # most, each with 5 s more for a step that ignores SIGTERM (a hung kernel):
 # 535 s, inside the device tool's 600 s for one command. Where GPU tests fail,
-# up to 2 x 20 s more rerun them with every launch waited for (below); a
-# check that needs those has already said what it must.
+# up to 2 x 20 s more rerun them with every launch waited for (below): 520 s,
+# 585 s at the worst, still inside the 600 s, and a check that needs those has
+# already said what it must.
 # Usage (from the repository root, on the GPU machine):
 #   scripts/device-check.sh [BUNDLE] [OUT] [check|runs]
 #     BUNDLE: what scripts/device-bundle.sh packed here (default build/device-bundle)
@@ -55,7 +56,7 @@ started=$(date +%s)
 # what the machine is, before anything can fail: enough to diagnose a failure
 # from OUT alone (with the machine's own libraries: the bundle's come after).
 # The bundle's CUDA 13 runtime needs driver 580 or newer; an older one makes
-# every GPU step exit 77 with that reason. Without persistence mode each CUDA
+# the first GPU step exit 77 with that reason, and the check stop there. Without persistence mode each CUDA
 # process start pays the driver's initialisation (seconds).
 {
   date -u
@@ -264,10 +265,18 @@ fi
 rerun_blocking() {  # rerun_blocking NAME PROGRAM, after step NAME ran PROGRAM
   local name=$1 program=$2 tests
   ((last_rc == 0 || last_rc == 77)) && return
-  tests=$(sed -n 's/^\[  FAILED  \] \([A-Za-z0-9_/]*\.[A-Za-z0-9_/]*\).*/\1/p' "$work/$name.log" | sort -u |
-    head -n 5 | paste -sd: -)
-  [[ -z $tests ]] && tests=$(sed -n 's/^\[ RUN      \] \([A-Za-z0-9_/]*\.[A-Za-z0-9_/]*\).*/\1/p' \
-    "$work/$name.log" | tail -n 1)
+  [[ -f $work/$name.log ]] || return
+  # the first failures in the order they failed (the first is the one that
+  # counts: a fault fails everything after it), at most four, and the test
+  # the program died in, if it died within one
+  tests=$(awk '$1 == "[" && $3 == "]" && $4 ~ /\./ {
+      name = $4; sub(/,$/, "", name)
+      if ($2 == "RUN") running = name
+      else if ($2 == "OK") running = ""
+      else if ($2 == "FAILED") { running = ""; if (!seen[name]++ && n < 4) failed[n++] = name }
+    }
+    END { for (i = 0; i < n; ++i) print failed[i]; if (running != "" && !seen[running]) print running }' \
+    "$work/$name.log" | paste -sd: -)
   [[ -z $tests ]] && return
   step "$name-blocking" 20 env CUDA_LAUNCH_BLOCKING=1 "$program" --gtest_filter="$tests"
 }

@@ -30,7 +30,8 @@ GpuQuery query_gpus();
 // Lets go of what query_gpus took on each GPU (a context, hundreds of MB of
 // the GPU's memory, and in exclusive mode the GPU itself) for a process that
 // only asks and runs nothing there (the sweep's orchestrator, whose workers
-// then take the GPUs). Destroys every allocation of this process on them.
+// then take the GPUs; a GPU test before it starts `flocsim run` as a child).
+// Destroys every allocation of this process on them.
 void release_gpus();
 // Makes the first usable GPU the current one for this thread (what every
 // allocation and launch of the back-end uses) and returns it; throws with
