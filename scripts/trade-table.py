@@ -3,7 +3,9 @@
 at two or more U_inf, the same seeds at each.
 
 SOURCE is either a folder holding each run as U<U_inf>-seed<seed>/result.json, or a runs.csv
-with one row per run (columns U_inf, seed, F, F_err, U_over_Uinf, U_over_Uinf_err, C_sph,
+with one row per run. In a folder, U<U_inf>-<variant>-seed<seed> (say U0.07-papers-method-seed1)
+holds a run at that U_inf that differs from the trade's in one named way (another coupling
+method, say): its runs make a group of their own, compared with the reference like another U_inf (columns U_inf, seed, F, F_err, U_over_Uinf, U_over_Uinf_err, C_sph,
 C_sph_err, n_a_mean, n_a_mean_err, Re_T, Re_T_err, max_liquid_speed_over_U_inf,
 max_liquid_Mach, coupling_worst_window, mass_balance_rel, momentum_balance_rel, steps, wall_s).
 
@@ -68,25 +70,33 @@ def run_from_csv(row, where):
             'steps': int(number('steps')), 'wall_s': number('wall_s')}
 
 
+def label(group):
+    """A group of runs, (U_inf, variant), as the tables name it: 0.07, or 0.07 papers-method."""
+    U_inf, variant = group
+    return f"{U_inf:g}" + (f" {variant}" if variant else '')
+
+
 def load(source):
-    """{U_inf: {seed: run}}, every figure finite and the same seeds at every U_inf."""
+    """{(U_inf, variant): {seed: run}}, every figure finite and the same seeds in every group; the
+    variant is '' for the trade's own runs."""
     runs = {}
 
-    def add(U_inf, seed, run, where):
-        if seed in runs.setdefault(U_inf, {}):
-            fail(f"{where}: a second run at U_inf {U_inf:g}, seed {seed}: which one the table means is not clear")
-        runs[U_inf][seed] = run
+    def add(group, seed, run, where):
+        if seed in runs.setdefault(group, {}):
+            fail(f"{where}: a second run at U_inf {label(group)}, seed {seed}: which one the table means is not clear")
+        runs[group][seed] = run
 
     path = pathlib.Path(source)
     if path.is_dir():
         for folder in sorted(path.glob('U*-seed*')):
-            match = re.fullmatch(r'U([0-9.]+)-seed([0-9]+)', folder.name)
+            match = re.fullmatch(r'U([0-9.]+)(?:-([a-z][a-z0-9-]*))?-seed([0-9]+)', folder.name)
             if not match:
-                fail(f"{folder}: not named U<U_inf>-seed<seed>; rename it or move it out of {source}")
+                fail(f"{folder}: not named U<U_inf>-seed<seed> or U<U_inf>-<variant>-seed<seed>; rename it "
+                     f"or move it out of {source}")
             if not (folder / 'result.json').is_file():
                 fail(f"{folder}: no result.json")
-            U_inf, seed = float(match.group(1)), int(match.group(2))
-            add(U_inf, seed, run_from_result(folder / 'result.json', U_inf, seed), folder)
+            U_inf, seed = float(match.group(1)), int(match.group(3))
+            add((U_inf, match.group(2) or ''), seed, run_from_result(folder / 'result.json', U_inf, seed), folder)
     elif path.is_file():
         for line, row in enumerate(csv.DictReader(open(path)), start=2):
             where = f"{source}, line {line}"
@@ -95,20 +105,21 @@ def load(source):
                 U_inf, seed = float(row['U_inf']), int(row['seed'])
             except (KeyError, TypeError, ValueError):
                 fail(f"{where}: U_inf {row.get('U_inf')!r} and seed {row.get('seed')!r} must be a number and an integer")
-            add(U_inf, seed, run, where)
+            add((U_inf, ''), seed, run, where)
     else:
         fail(f"{source}: neither a folder of runs nor a runs.csv")
-    if len(runs) < 2:
-        fail(f"{source}: a trade needs runs at two U_inf at least, found {sorted(runs)}")
-    seed_sets = {U_inf: sorted(seeds) for U_inf, seeds in runs.items()}
+    if len({U_inf for U_inf, _ in runs}) < 2:
+        fail(f"{source}: a trade needs runs at two U_inf at least, found {sorted(label(g) for g in runs)}")
+    seed_sets = {label(group): sorted(seeds) for group, seeds in runs.items()}
     if len(set(map(tuple, seed_sets.values()))) != 1:
         fail(f"{source}: the seeds differ between U_inf ({seed_sets}): the means would not compare")
-    for U_inf, seeds in runs.items():
+    for group, seeds in runs.items():
         for seed, run in seeds.items():
             for key, (mean, error) in run['figures'].items():
                 if not (math.isfinite(mean) and math.isfinite(error)):
-                    fail(f"{source}: U_inf {U_inf:g} seed {seed}: {key} is {mean} +- {error}")
-    return dict(sorted(runs.items(), reverse=True))
+                    fail(f"{source}: U_inf {label(group)} seed {seed}: {key} is {mean} +- {error}")
+    # the trade's own runs, largest U_inf first, then the variants
+    return dict(sorted(runs.items(), key=lambda item: (item[0][1] != '', -item[0][0], item[0][1])))
 
 
 def mean_and_error(values, errors):
@@ -139,38 +150,38 @@ def per_run_table(runs):
     lines = ['| U_inf, seed | ' + ' | '.join(f[0] for f in FIGURES) +
              ' | largest liquid speed (U_inf); Mach | coupling monitor, worst window |',
              '|---' * (len(FIGURES) + 3) + '|']
-    for U_inf, seeds in runs.items():
+    for group, seeds in runs.items():
         for seed, run in sorted(seeds.items()):
             cells = [f"{run['figures'][key][0]:.{digits}f} +- {run['figures'][key][1]:.{digits}f}"
                      for _, key, digits, _ in FIGURES]
-            lines.append(f"| {U_inf:g}, {seed} | " + ' | '.join(cells) +
+            lines.append(f"| {label(group)}, {seed} | " + ' | '.join(cells) +
                          f" | {run['speed_over_U_inf']:.2f}; {run['Mach']:.3f} | {short_exponent(run['monitor'])} |")
     return lines
 
 
 def means_table(runs, reference):
-    means = {U_inf: {key: mean_and_error([run['figures'][key][0] for run in seeds.values()],
+    means = {group: {key: mean_and_error([run['figures'][key][0] for run in seeds.values()],
                                          [run['figures'][key][1] for run in seeds.values()])
                      for _, key, _, _ in FIGURES}
-             for U_inf, seeds in runs.items()}
+             for group, seeds in runs.items()}
     lines = ['| | ' + ' | '.join(f[0] for f in FIGURES) + ' |', '|---' * (len(FIGURES) + 1) + '|']
-    for U_inf, m in means.items():
-        lines.append(f"| U_inf {U_inf:g} | " +
+    for group, m in means.items():
+        lines.append(f"| U_inf {label(group)} | " +
                      ' | '.join(f"{m[key][0]:.{digits}f} +- {m[key][1]:.{digits}f}" for _, key, _, digits in FIGURES) +
                      ' |')
-    for U_inf in (U for U in means if U != reference):
-        cells = [difference_cell(*means[reference][key], *means[U_inf][key]) for _, key, _, _ in FIGURES]
-        lines.append(f"| {reference:g} against {U_inf:g} | " + ' | '.join(cells) + ' |')
+    for group in (g for g in means if g != reference):
+        cells = [difference_cell(*means[reference][key], *means[group][key]) for _, key, _, _ in FIGURES]
+        lines.append(f"| {label(reference)} against {label(group)} | " + ' | '.join(cells) + ' |')
     return lines
 
 
 def footer(runs):
-    every = [(U_inf, seed, run) for U_inf, seeds in runs.items() for seed, run in sorted(seeds.items())]
+    every = [(label(group), seed, run) for group, seeds in runs.items() for seed, run in sorted(seeds.items())]
     overlaps = [run['overlap'] for _, _, run in every if run['overlap'] is not None]
     return (f"over every run: mass to {max(run['mass'] for _, _, run in every):.1e} of the liquid's, momentum to "
             f"{max(run['momentum'] for _, _, run in every):.1e} of the spheres'" +
             (f", worst overlap {max(overlaps):g}" if overlaps else '') + "; steps and wall time: " +
-            ', '.join(f"{U_inf:g} seed {seed} {run['steps']} in {run['wall_s'] / 60:.1f} min" for U_inf, seed, run in every))
+            ', '.join(f"{name} seed {seed} {run['steps']} in {run['wall_s'] / 60:.1f} min" for name, seed, run in every))
 
 
 def find_table(doc_lines, block):
@@ -186,14 +197,20 @@ def find_table(doc_lines, block):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--reference', type=float, help='the U_inf the others are compared with (default: the largest)')
+    parser.add_argument('--reference', type=float,
+                        help="the U_inf whose own runs the others are compared with (default: the largest)")
     parser.add_argument('--check', metavar='DOC', help='fail unless DOC holds the tables, row for row')
     parser.add_argument('source', metavar='SOURCE')
     args = parser.parse_args()
     runs = load(args.source)
-    reference = max(runs) if args.reference is None else args.reference
+    plain = [U_inf for U_inf, variant in runs if not variant]
+    if not plain:
+        fail(f"{args.source}: no runs of the trade's own (U<U_inf>-seed<seed>), only variants: "
+             f"{sorted(label(g) for g in runs)}")
+    reference = (max(plain) if args.reference is None else args.reference, '')
     if reference not in runs:
-        fail(f"--reference {reference:g}: no runs at that U_inf (there are {sorted(runs)})")
+        fail(f"--reference {args.reference}: no runs of the trade's own at that U_inf "
+             f"(there are {sorted(label(g) for g in runs)})")
 
     blocks = [means_table(runs, reference)]
     if pathlib.Path(args.source).is_dir():
