@@ -3,22 +3,25 @@
 at two or more U_inf, the same seeds at each.
 
 SOURCE is either a folder holding each run as U<U_inf>-seed<seed>/result.json, or a runs.csv
-with one row per run. In a folder, U<U_inf>-<variant>-seed<seed> (say U0.07-papers-method-seed1)
-holds a run at that U_inf that differs from the trade's in one named way (another coupling
-method, say): its runs make a group of their own, compared with the reference like another U_inf (columns U_inf, seed, F, F_err, U_over_Uinf, U_over_Uinf_err, C_sph,
+with one row per run (columns U_inf, seed, F, F_err, U_over_Uinf, U_over_Uinf_err, C_sph,
 C_sph_err, n_a_mean, n_a_mean_err, Re_T, Re_T_err, max_liquid_speed_over_U_inf,
 max_liquid_Mach, coupling_worst_window, mass_balance_rel, momentum_balance_rel, steps, wall_s).
+A folder may also hold runs named U<U_inf>-<variant>-seed<seed> (say U0.07-papers-method-seed1):
+runs at that U_inf that differ from the trade's in one named way (another coupling method, say).
+Each variant is a group of its own, listed after the trade's runs and compared with the reference
+like another U_inf; a runs.csv holds the trade's own runs only.
 
 First table, one row per run: F, U/U_inf, C_sph, <n_a>, Re_T with the batch-means error each run
 gives, the largest liquid speed in U_inf and its Mach number, and the coupling monitor's worst
 window.
 
-Second table, one row per U_inf: the mean over its seeds, whose error is the larger of the seeds'
-scatter (sample standard deviation over sqrt(seeds)) and the runs' combined batch errors (root of
-the sum of their squares over the number of seeds). Then the reference U_inf (the largest, the
-preset's, unless --reference names another) against each other: the relative difference
-a/b - 1, its error (the ratio's: a/b times the two relative errors in quadrature), and in
-brackets |a/b - 1| in units of that error. Below: the balances and each run's steps and wall time.
+Second table, one row per group (each U_inf of the trade, then each variant): the mean over its
+seeds, whose error is the larger of the seeds' scatter (sample standard deviation over sqrt(seeds))
+and the runs' combined batch errors (root of the sum of their squares over the number of seeds).
+Then the reference (the trade's own runs at the largest U_inf, the preset's, unless --reference
+names another) against each other group: the relative difference a/b - 1, its error (the ratio's:
+a/b times the two relative errors in quadrature), and in brackets |a/b - 1| in units of that error.
+Below: the balances and each run's steps and wall time.
 
 --check DOC fails unless DOC holds each table as one whole table, row for row (for a runs.csv,
 whose per-run figures stay in the file, the second table only). The trades' tables in
@@ -108,11 +111,11 @@ def load(source):
             add((U_inf, ''), seed, run, where)
     else:
         fail(f"{source}: neither a folder of runs nor a runs.csv")
-    if len({U_inf for U_inf, _ in runs}) < 2:
+    if len({U_inf for U_inf, variant in runs if not variant}) < 2:
         fail(f"{source}: a trade needs runs at two U_inf at least, found {sorted(label(g) for g in runs)}")
     seed_sets = {label(group): sorted(seeds) for group, seeds in runs.items()}
     if len(set(map(tuple, seed_sets.values()))) != 1:
-        fail(f"{source}: the seeds differ between U_inf ({seed_sets}): the means would not compare")
+        fail(f"{source}: the seeds differ between groups ({seed_sets}): the means would not compare")
     for group, seeds in runs.items():
         for seed, run in seeds.items():
             for key, (mean, error) in run['figures'].items():
