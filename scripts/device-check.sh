@@ -56,8 +56,9 @@ started=$(date +%s)
 # what the machine is, before anything can fail: enough to diagnose a failure
 # from OUT alone (with the machine's own libraries: the bundle's come after).
 # The bundle's CUDA 13 runtime needs driver 580 or newer; an older one makes
-# the first GPU step exit 77 with that reason, and the check stop there. Without persistence mode each CUDA
-# process start pays the driver's initialisation (seconds).
+# the first GPU step exit 77 with that reason, and the check stop there.
+# Without persistence mode each CUDA process start pays the driver's
+# initialisation (seconds).
 {
   date -u
   nvidia-smi --query-gpu=name,memory.total,clocks.max.memory,driver_version,compute_mode,persistence_mode --format=csv
