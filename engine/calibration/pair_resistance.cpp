@@ -27,52 +27,103 @@ double input_radius_of(double a, const PairResistanceSettings& set) {
              : CalibrationTable::shipped().input_radius(a, set.viscosity, set.scheme);
 }
 
+// How the held pair moves; sphere 0 sits at -x of the box's centre, sphere 1
+// at +x, each sphere's surface moving at V where it faces the other.
+enum class PairMotion { approach, separate, slide, roll };
+
+// The force and torque on sphere 0 once steady, in units of 6 pi rho nu a V
+// and 8 pi rho nu a^2 V.
+struct HeldPairReading {
+  spheres::Vec3 force = spheres::Vec3::Zero(), torque = spheres::Vec3::Zero();
+  long steps = 0;
+};
+
 // Two spheres of hydrodynamic radius a held on the x axis of a periodic box
-// L x L/2 x L/2, moving along their line of centres at +-V, without lubrication.
+// L x L/2 x L/2, moving at speed V, without lubrication.
 class HeldPair {
  public:
-  HeldPair(double a, bool separating, const PairResistanceSettings& set)
+  HeldPair(double a, PairMotion motion, const PairResistanceSettings& set)
       : a_(a),
         nu_(set.viscosity),
         box_(static_cast<int>(std::lround(set.box_over_a * a / 2)) * 2),
-        towards_(separating ? -1.0 : 1.0),
         V_(0.5 * set.reynolds * set.viscosity / a),
+        motion_(motion),
         set_(set),
         fluid_({box_, box_ / 2, box_ / 2}, {set.viscosity, 0.25}),
         coupling_(coupling::make_coupling<double>(set.scheme, input_radius_of(a, set))) {
     fluid_.initialise_equilibrium([](int, int, int) { return lattice::Macroscopic{}; });
     pair_.radius = a;
     pair_.resize(2);
-    pair_.velocity[0] = {towards_ * V_, 0, 0};
-    pair_.velocity[1] = {-towards_ * V_, 0, 0};
+    switch (motion) {
+      case PairMotion::approach:
+      case PairMotion::separate: {
+        const double towards = motion == PairMotion::approach ? 1.0 : -1.0;
+        pair_.velocity[0] = {towards * V_, 0, 0};
+        pair_.velocity[1] = {-towards * V_, 0, 0};
+        break;
+      }
+      case PairMotion::slide:  // the facing surfaces slip past each other at 2V
+        pair_.velocity[0] = {0, V_, 0};
+        pair_.velocity[1] = {0, -V_, 0};
+        break;
+      case PairMotion::roll:  // counter-rotating: the facing surfaces both move at +V along y
+        pair_.angular_velocity[0] = {0, 0, V_ / a};
+        pair_.angular_velocity[1] = {0, 0, -V_ / a};
+        break;
+    }
   }
 
-  // Moves the pair to gap s and runs until the force is steady.
-  PairResistancePoint measure(double gap_over_a) {
+  // Moves the pair to gap s and runs until the force and torque on sphere 0
+  // are steady: the component that resists the motion (`primary`, of
+  // `force` or `torque`) changes by less than the tolerance per 200 steps,
+  // three checks running, and the other one by less than the tolerance
+  // relative to the primary's size.
+  HeldPairReading measure(double gap_over_a) {
     // off the lattice's symmetry planes, so that no marker sits on a node by design
     const double cx = 0.5 * box_, cy = 0.25 * box_ + 0.37, cz = 0.25 * box_ + 0.21;
     pair_.position[0] = {cx - a_ - 0.5 * gap_over_a * a_, cy, cz};
     pair_.position[1] = {cx + a_ + 0.5 * gap_over_a * a_, cy, cz};
-    PairResistancePoint p{.gap_over_a = gap_over_a,
-                          .lambda_exact = lubrication::brenner_pair_resistance(gap_over_a)};
-    double last = 0;
+    HeldPairReading r;
+    const double force_unit = 6 * M_PI * nu_ * a_ * V_, torque_unit = 8 * M_PI * nu_ * a_ * a_ * V_;
+    const bool tangential = motion_ == PairMotion::slide || motion_ == PairMotion::roll;
+    auto primary = [&](const HeldPairReading& x) {
+      return motion_ == PairMotion::roll ? x.torque.z() : tangential ? x.force.y() : x.force.x();
+    };
+    auto secondary = [&](const HeldPairReading& x) {
+      return motion_ == PairMotion::roll    ? x.force.y()
+             : motion_ == PairMotion::slide ? x.torque.z()
+                                            : 0.0;
+    };
+    HeldPairReading last;
     int quiet_checks = 0;  // consecutive checks below the tolerance
     for (long step = 1; step <= set_.max_steps; ++step) {
       coupling_->apply(fluid_, pair_);
       fluid_.step();
       coupling_->after_liquid_step(fluid_, pair_);
+      if (tangential) {
+        // Rolling pushes both spheres the same way (and the lattice's grid
+        // need not cancel sliding's two forces exactly): a body force returns
+        // their sum to the liquid, whose mean momentum a periodic box would
+        // otherwise grow until the spheres' drag on the drift cancelled it.
+        const spheres::Vec3 back = (coupling_->force()[0] + coupling_->force()[1]) /
+                                   (static_cast<double>(box_) * (box_ / 2) * (box_ / 2));
+        fluid_.set_body_force({back.x(), back.y(), back.z()});
+      }
       if (step % 200 != 0) continue;
-      // the force on sphere 0 opposes its motion, which is +x when approaching
-      const double lambda = -towards_ * coupling_->force()[0].x() / (6 * M_PI * nu_ * a_ * V_);
-      if (!std::isfinite(lambda))
+      r.force = coupling_->force()[0] / force_unit;
+      r.torque = coupling_->torque()[0] / torque_unit;
+      r.steps = step;
+      const double p = primary(r);
+      if (!std::isfinite(p) || !std::isfinite(secondary(r)))
         throw std::runtime_error("pair resistance: the measurement blew up at gap " +
                                  std::to_string(gap_over_a) + " a");
-      p.lambda_measured = lambda;
-      p.steps = step;
+      const double tol = set_.tolerance * std::abs(p);
       quiet_checks =
-          std::abs(lambda - last) < set_.tolerance * std::abs(lambda) ? quiet_checks + 1 : 0;
-      if (step > 1000 && quiet_checks >= 3) return p;
-      last = lambda;
+          std::abs(p - primary(last)) < tol && std::abs(secondary(r) - secondary(last)) < tol
+              ? quiet_checks + 1
+              : 0;
+      if (step > 1000 && quiet_checks >= 3) return r;
+      last = r;
     }
     throw std::runtime_error("pair resistance: not steady after " + std::to_string(set_.max_steps) +
                              " steps at gap " + std::to_string(gap_over_a) + " a");
@@ -83,19 +134,32 @@ class HeldPair {
  private:
   double a_, nu_;
   int box_;
-  double towards_, V_;
+  double V_;
+  PairMotion motion_;
   PairResistanceSettings set_;
   lattice::FluidLattice<double> fluid_;
   std::unique_ptr<coupling::SphereCoupling<double>> coupling_;
   spheres::SphereSet pair_;
 };
 
+PairMotion radial_motion(bool separating) {
+  return separating ? PairMotion::separate : PairMotion::approach;
+}
+
+// lambda: the force on sphere 0 against its radial motion (+x when approaching)
+PairResistancePoint radial_point(double gap_over_a, bool separating, const HeldPairReading& r) {
+  return {.gap_over_a = gap_over_a,
+          .lambda_measured = (separating ? 1.0 : -1.0) * r.force.x(),
+          .lambda_exact = lubrication::brenner_pair_resistance(gap_over_a),
+          .steps = r.steps};
+}
+
 }  // namespace
 
 PairResistancePoint measure_pair_resistance(double a, double gap_over_a, bool separating,
                                             const PairResistanceSettings& set) {
-  HeldPair pair(a, separating, set);
-  return pair.measure(gap_over_a);
+  HeldPair pair(a, radial_motion(separating), set);
+  return radial_point(gap_over_a, separating, pair.measure(gap_over_a));
 }
 
 std::vector<double> default_pair_gaps() {
@@ -124,19 +188,34 @@ PairResistanceEntry calibrate_pair_resistance(double a, const std::vector<double
   for (std::size_t k = 0; k < gaps.size(); ++k)
     if (!(gaps[k] > 0) || (k > 0 && gaps[k] <= gaps[k - 1]))
       throw std::invalid_argument("pair resistance: gaps must be positive and increasing");
-  HeldPair pair(a, separating, s);
+  HeldPair pair(a, radial_motion(separating), s);
   PairResistanceEntry e{.hydrodynamic_radius = a,
                         .viscosity = s.viscosity,
                         .scheme = s.scheme,
                         .box = pair.box(),
                         .separating = separating};
   for (double g : gaps) {
-    e.points.push_back(pair.measure(g));
+    e.points.push_back(radial_point(g, separating, pair.measure(g)));
     if (progress) progress(e.points.back());
   }
   e.box_offset = e.points.back().lambda_measured - e.points.back().lambda_exact;
   e.input_radius = input_radius_of(a, s);
   return e;
+}
+
+std::vector<PairTangentialPoint> measure_pair_tangential(
+    double a, const std::vector<double>& gaps, TangentialMotion motion,
+    const PairResistanceSettings& s, void (*progress)(const PairTangentialPoint&)) {
+  if (gaps.empty()) throw std::invalid_argument("pair resistance: no gaps to measure");
+  HeldPair pair(a, motion == TangentialMotion::slide ? PairMotion::slide : PairMotion::roll, s);
+  std::vector<PairTangentialPoint> points;
+  for (double g : gaps) {
+    const HeldPairReading r = pair.measure(g);
+    points.push_back(
+        {.gap_over_a = g, .force_y = r.force.y(), .torque_z = r.torque.z(), .steps = r.steps});
+    if (progress) progress(points.back());
+  }
+  return points;
 }
 
 // ---- the table ----

@@ -72,6 +72,34 @@ PairResistanceEntry calibrate_pair_resistance(
     double hydrodynamic_radius, const std::vector<double>& gaps, bool separating,
     const PairResistanceSettings& s, void (*progress)(const PairResistancePoint&) = nullptr);
 
+// The held pair's tangential relative motions, which a bonded pair in an
+// aggregate makes when it is sheared or rolled (docs/contacts.md, "A bonded
+// pair sheared and rolled"); only measured, not calibrated: the lubrication
+// correction acts along the line of centres only.
+//   slide: sphere 0 moves at +V along y, sphere 1 at -V, neither rotates: the
+//          facing surfaces slip past each other at 2V, the motion whose
+//          resistance grows as ln(a/s) at contact;
+//   roll:  neither translates, sphere 0 rotates at +V/a about z, sphere 1 at
+//          -V/a: the facing surfaces both move at +V along y, no slip across
+//          the gap (relative rolling, finite at contact).
+enum class TangentialMotion { slide, roll };
+
+// Force and torque on sphere 0 (at -x of the pair's centre), signed, in units
+// of 6 pi rho nu a V and 8 pi rho nu a^2 V: an isolated sphere would read
+// force_y = -1 when sliding and torque_z = -1 when rolling. The box's images
+// are included (no offset removed).
+struct PairTangentialPoint {
+  double gap_over_a = 0;
+  double force_y = 0;
+  double torque_z = 0;
+  long steps = 0;
+};
+
+// All gaps in one box, each from the steady flow of the one before.
+std::vector<PairTangentialPoint> measure_pair_tangential(
+    double hydrodynamic_radius, const std::vector<double>& gaps, TangentialMotion motion,
+    const PairResistanceSettings& s, void (*progress)(const PairTangentialPoint&) = nullptr);
+
 // The `flocsim calibrate --close-pairs` command that makes the entry a case at
 // radius a, viscosity nu and IB scheme lacks (a >= 6 in a 12a box, as the
 // shipped a = 6 entries: a 16a box costs 2.4x more for the same lambda_IB

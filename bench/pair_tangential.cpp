@@ -1,0 +1,135 @@
+// A bonded pair sheared and rolled (docs/contacts.md, "A bonded pair sheared
+// and rolled"): the lattice's own resistance of two held spheres to the
+// tangential relative motions an aggregate's bonds make, per coupling scheme,
+// beside the exact creeping-flow values near contact. The close-pair
+// correction acts along the line of centres only, so this resistance is the
+// lattice's alone in every run.
+//
+//   bench_pair_tangential [--radius A] [--viscosity NU] [--box L_OVER_A]
+//                         [--options OPTION,...] [--motions slide,roll]
+//                         [--gaps S,...] [--json FILE]
+//
+// Options as bench_coupling (direct:KERNEL:SPACING:SWEEPS,
+// control:KERNEL:SPACING[:G:P], psm), each with the input radius the shipped
+// calibration gives at a and nu. Per option and motion, the pair is held at
+// each gap s/a (increasing; each gap starts from the steady flow of the one
+// before) in a box L x L/2 x L/2 (L = L_OVER_A a, default 16), at a surface
+// speed V with 2 a V / nu = 0.01, double precision, until steady to 2e-6 per
+// 200 steps (engine/calibration/pair_resistance.hpp, measure_pair_tangential).
+// Printed per gap: the force on sphere 0 along y and its torque about z, in
+// units of 6 pi rho nu a V and 8 pi rho nu a^2 V (signed: an isolated sphere
+// reads -1 for the force when sliding and -1 for the torque when rolling).
+// The box's periodic images are included: compare schemes in the same box.
+#include <omp.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "bench/coupling_options.hpp"
+#include "engine/calibration/pair_resistance.hpp"
+
+using namespace flocsim;
+
+namespace {
+
+int refuse(const std::string& what) {
+  std::fprintf(stderr, "bench_pair_tangential: %s\n", what.c_str());
+  return 2;
+}
+
+void print_point(const calibration::PairTangentialPoint& p) {
+  std::printf("  s/a = %6.3f  force_y = %+9.5f  torque_z = %+9.5f  steps %7ld\n", p.gap_over_a,
+              p.force_y, p.torque_z, p.steps);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double a = 4, nu = 0.02, box = 16;
+  std::string options = "direct:roma3:0.7:2,psm", motions = "slide,roll";
+  std::vector<double> gaps = {0.005, 0.01, 0.02, 0.035, 0.05, 0.1, 0.2, 0.5};
+  std::string json_file;
+  for (int i = 1; i < argc; i += 2) {
+    const std::string arg = argv[i];
+    if (i + 1 >= argc) return refuse(arg + ": needs a value");
+    const std::string v = argv[i + 1];
+    try {
+      if (arg == "--radius")
+        a = std::stod(v);
+      else if (arg == "--viscosity")
+        nu = std::stod(v);
+      else if (arg == "--box")
+        box = std::stod(v);
+      else if (arg == "--options")
+        options = v;
+      else if (arg == "--motions")
+        motions = v;
+      else if (arg == "--json")
+        json_file = v;
+      else if (arg == "--gaps") {
+        gaps.clear();
+        for (const auto& g : bench::split(v, ',')) gaps.push_back(std::stod(g));
+      } else
+        return refuse("unknown option " + arg);
+    } catch (const std::exception&) {
+      return refuse(arg + " " + v + ": not a number");
+    }
+  }
+  if (!(a >= 2 && a <= 16)) return refuse("--radius " + std::to_string(a) + ": allowed 2-16 dx");
+  if (!(nu >= 0.005 && nu <= 0.5))
+    return refuse("--viscosity " + std::to_string(nu) + ": allowed 0.005-0.5");
+  if (!(box >= 8 && box <= 64)) return refuse("--box " + std::to_string(box) + ": allowed 8-64");
+  for (std::size_t k = 0; k < gaps.size(); ++k)
+    if (!(gaps[k] > 0 && gaps[k] <= 2) || (k > 0 && gaps[k] <= gaps[k - 1]))
+      return refuse("--gaps: each in (0, 2], increasing");
+  std::vector<coupling::Scheme> schemes;
+  for (const auto& text : bench::split(options, ',')) {
+    const auto s = bench::parse_option(text);
+    if (!s) return refuse("--options " + text + ": allowed " + bench::kOptionsSyntax);
+    schemes.push_back(*s);
+  }
+  std::vector<calibration::TangentialMotion> wanted;
+  for (const auto& m : bench::split(motions, ',')) {
+    if (m == "slide")
+      wanted.push_back(calibration::TangentialMotion::slide);
+    else if (m == "roll")
+      wanted.push_back(calibration::TangentialMotion::roll);
+    else
+      return refuse("--motions " + m + ": allowed slide, roll");
+  }
+
+  std::printf("bench_pair_tangential: a = %g dx, nu = %g, box %g a, %d threads\n", a, nu, box,
+              omp_get_max_threads());
+  nlohmann::json out = {{"radius", a}, {"viscosity", nu}, {"box_over_a", box}, {"runs", {}}};
+  for (const auto& scheme : schemes) {
+    calibration::PairResistanceSettings set;
+    set.viscosity = nu;
+    set.scheme = scheme;
+    set.box_over_a = box;
+    for (auto motion : wanted) {
+      const bool slide = motion == calibration::TangentialMotion::slide;
+      std::printf("%s, %s:\n", scheme.describe().c_str(), slide ? "slide" : "roll");
+      const auto points = calibration::measure_pair_tangential(a, gaps, motion, set, print_point);
+      nlohmann::json run = {{"scheme", scheme.describe()},
+                            {"motion", slide ? "slide" : "roll"},
+                            {"points", nlohmann::json::array()}};
+      for (const auto& p : points) {
+        run["points"].push_back({{"gap_over_a", p.gap_over_a},
+                                 {"force_y", p.force_y},
+                                 {"torque_z", p.torque_z},
+                                 {"steps", p.steps}});
+      }
+      out["runs"].push_back(run);
+      if (!json_file.empty()) {  // after every run, so a long study keeps what it has
+        std::ofstream f(json_file);
+        f << out.dump(2) << "\n";
+        if (!f) return refuse("cannot write " + json_file);
+      }
+    }
+  }
+  return 0;
+}
