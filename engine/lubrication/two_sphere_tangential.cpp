@@ -34,14 +34,10 @@ class Multipoles {
   }
 
   double P(int n, int p, int q) {
-    if (p < 0 || q < 0) return 0;
-    double& memo = P_[index3(n, p, q)];
-    if (!std::isnan(memo)) return memo;
-    double sum = 0;
-    if (p == 0 && q == 0) {
-      sum = !rotation_ && n == 1 ? 1 : 0;
-    } else {
+    return memoised(P_, n, p, q, [&] {
+      if (p == 0 && q == 0) return !rotation_ && n == 1 ? 1.0 : 0.0;
       const double N = n;
+      double sum = 0;
       for (int s = 1; s <= q; ++s) {
         const double S = s;
         const double term =
@@ -52,42 +48,44 @@ class Multipoles {
             2 * (4 * N * N - 1) / (3 * (N + 1)) * Q(s, q - s - 1, p - n + 1);
         sum += choose(n + s, n + 1) * term;
       }
-    }
-    return memo = sum;
+      return sum;
+    });
   }
 
   double Q(int n, int p, int q) {
-    if (p < 0 || q < 0) return 0;
-    double& memo = Q_[index3(n, p, q)];
-    if (!std::isnan(memo)) return memo;
-    double sum = 0;
-    if (p == 0 && q == 0) {
-      sum = rotation_ && n == 1 ? 1 : 0;
-    } else {
+    return memoised(Q_, n, p, q, [&] {
+      if (p == 0 && q == 0) return rotation_ && n == 1 ? 1.0 : 0.0;
       const double N = n;
+      double sum = 0;
       for (int s = 1; s <= q; ++s)
         sum += choose(n + s, n + 1) * (s / (N + 1) * Q(s, q - s - 1, p - n) -
                                        3 / (2 * N * s * (N + 1)) * P(s, q - s, p - n));
-    }
-    return memo = sum;
+      return sum;
+    });
   }
 
   double V(int n, int p, int q) {
-    if (p < 0 || q < 0) return 0;
-    double& memo = V_[index3(n, p, q)];
-    if (!std::isnan(memo)) return memo;
-    double sum = 0;
-    if (p == 0 && q == 0) {
-      sum = !rotation_ && n == 1 ? 1 : 0;
-    } else {
+    return memoised(V_, n, p, q, [&] {
+      if (p == 0 && q == 0) return !rotation_ && n == 1 ? 1.0 : 0.0;
       const double N = n;
+      double sum = 0;
       for (int s = 1; s <= q; ++s) sum += choose(n + s, n + 1) * P(s, q - s, p - n - 1);
-      sum = P(n, p, q) + 2 * N / ((N + 1) * (2 * N + 3)) * sum;
-    }
-    return memo = sum;
+      return P(n, p, q) + 2 * N / ((N + 1) * (2 * N + 3)) * sum;
+    });
   }
 
  private:
+  // table's entry (n, p, q), computed once; 0 where p or q is negative (the
+  // recurrences reach past the edge of the index space). The tables never
+  // grow, so a reference into one outlives the recursion below it.
+  template <class Compute>
+  double memoised(std::vector<double>& table, int n, int p, int q, Compute compute) {
+    if (p < 0 || q < 0) return 0;
+    double& memo = table[index3(n, p, q)];
+    if (std::isnan(memo)) memo = compute();
+    return memo;
+  }
+
   std::size_t index3(int n, int p, int q) const {
     if (n >= size_ || p >= size_ || q >= size_)
       throw std::logic_error("two-sphere series: coefficient beyond its order");
