@@ -1,5 +1,5 @@
 // A bonded pair sheared and rolled (docs/contacts.md, "A bonded pair sheared
-// and rolled"): the lattice's own resistance of two held spheres to the
+// and rolled (measured)"): the lattice's own resistance of two held spheres to the
 // tangential relative motions an aggregate's bonds make, per coupling scheme,
 // beside the exact creeping-flow values near contact. The close-pair
 // correction acts along the line of centres only, so this resistance is the
@@ -57,10 +57,8 @@ Exact exact_pair(calibration::TangentialMotion motion, double gap_over_a) {
           -lubrication::rolling_pair_torque(gap_over_a)};
 }
 
-calibration::TangentialMotion printed_motion = calibration::TangentialMotion::slide;
-
-void print_point(const calibration::PairTangentialPoint& p) {
-  const Exact e = exact_pair(printed_motion, p.gap_over_a);
+void print_point(calibration::TangentialMotion motion, const calibration::PairTangentialPoint& p) {
+  const Exact e = exact_pair(motion, p.gap_over_a);
   std::printf(
       "  s/a = %6.3f  force_y = %+9.5f (exact %+8.5f)  torque_z = %+9.5f (exact %+8.5f)"
       "  steps %7ld\n",
@@ -77,6 +75,16 @@ int main(int argc, char** argv) {
   std::string json_file;
   for (int i = 1; i < argc; i += 2) {
     const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::printf(
+          "bench_pair_tangential [--radius A] [--viscosity NU] [--box L_OVER_A]\n"
+          "                      [--options OPTION,...] [--motions slide,roll]\n"
+          "                      [--gaps S,...] [--json FILE]\n"
+          "A held pair of spheres sliding and rolling, per coupling scheme, against the exact\n"
+          "pair (docs/contacts.md, \"A bonded pair sheared and rolled (measured)\"). OPTION: %s.\n",
+          bench::kOptionsSyntax);
+      return 0;
+    }
     if (i + 1 >= argc) return refuse(arg + ": needs a value");
     const std::string v = argv[i + 1];
     try {
@@ -124,6 +132,9 @@ int main(int argc, char** argv) {
       return refuse("--motions " + m + ": allowed slide, roll");
   }
 
+  if (!json_file.empty() && !std::ofstream(json_file, std::ios::app))  // before minutes of work
+    return refuse("--json " + json_file + ": cannot be written");
+
   std::printf("bench_pair_tangential: a = %g dx, nu = %g, box %g a, %d threads\n", a, nu, box,
               omp_get_max_threads());
   nlohmann::json out = {{"radius", a}, {"viscosity", nu}, {"box_over_a", box}, {"runs", {}}};
@@ -135,8 +146,13 @@ int main(int argc, char** argv) {
     for (auto motion : wanted) {
       const bool slide = motion == calibration::TangentialMotion::slide;
       std::printf("%s, %s:\n", scheme.describe().c_str(), slide ? "slide" : "roll");
-      printed_motion = motion;
-      const auto points = calibration::measure_pair_tangential(a, gaps, motion, set, print_point);
+      std::vector<calibration::PairTangentialPoint> points;
+      try {  // no calibration for this a and nu, a run that blew up or never settled
+        points = calibration::measure_pair_tangential(
+            a, gaps, motion, set, [motion](const auto& p) { print_point(motion, p); });
+      } catch (const std::exception& e) {
+        return refuse(e.what());
+      }
       nlohmann::json run = {{"scheme", scheme.describe()},
                             {"motion", slide ? "slide" : "roll"},
                             {"points", nlohmann::json::array()}};

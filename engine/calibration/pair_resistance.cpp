@@ -205,7 +205,8 @@ PairResistanceEntry calibrate_pair_resistance(double a, const std::vector<double
 
 std::vector<PairTangentialPoint> measure_pair_tangential(
     double a, const std::vector<double>& gaps, TangentialMotion motion,
-    const PairResistanceSettings& s, void (*progress)(const PairTangentialPoint&)) {
+    const PairResistanceSettings& s,
+    const std::function<void(const PairTangentialPoint&)>& progress) {
   if (gaps.empty()) throw std::invalid_argument("pair resistance: no gaps to measure");
   HeldPair pair(a, motion == TangentialMotion::slide ? PairMotion::slide : PairMotion::roll, s);
   std::vector<PairTangentialPoint> points;

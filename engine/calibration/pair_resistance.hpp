@@ -14,6 +14,7 @@
 // lattice resolves the gap by 2 dx or more and the pair is well described) as
 // lambda_measured - lambda_exact and removed at every gap:
 //   lambda_IB(s) = lambda_measured(s) - box_offset.
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,7 +75,7 @@ PairResistanceEntry calibrate_pair_resistance(
 
 // The held pair's tangential relative motions, which a bonded pair in an
 // aggregate makes when it is sheared or rolled (docs/contacts.md, "A bonded
-// pair sheared and rolled"); only measured, not calibrated: the lubrication
+// pair sheared and rolled (measured)"); only measured, not calibrated: the lubrication
 // correction acts along the line of centres only.
 //   slide: sphere 0 moves at +V along y, sphere 1 at -V, neither rotates: the
 //          facing surfaces slip past each other at 2V, the motion whose
@@ -98,7 +99,8 @@ struct PairTangentialPoint {
 // All gaps in one box, each from the steady flow of the one before.
 std::vector<PairTangentialPoint> measure_pair_tangential(
     double hydrodynamic_radius, const std::vector<double>& gaps, TangentialMotion motion,
-    const PairResistanceSettings& s, void (*progress)(const PairTangentialPoint&) = nullptr);
+    const PairResistanceSettings& s,
+    const std::function<void(const PairTangentialPoint&)>& progress = {});
 
 // The `flocsim calibrate --close-pairs` command that makes the entry a case at
 // radius a, viscosity nu and IB scheme lacks (a >= 6 in a 12a box, as the

@@ -1,7 +1,8 @@
 // The exact tangential resistance of two equal spheres (Jeffrey & Onishi's
 // series, engine/lubrication/two_sphere_tangential.hpp) against what it is
 // not computed from: an independent method's published values, the method of
-// reflections far apart, and lubrication theory's logarithms at contact.
+// reflections far apart, and an independent computation of the near-contact
+// forms.
 #include "engine/lubrication/two_sphere_tangential.hpp"
 
 #include <gtest/gtest.h>
@@ -43,34 +44,43 @@ TEST(TwoSphereTangential, AgreesWithWilsonsLambSolution) {
 // Far apart (x = a / r), the first reflections: sphere 2's Stokeslet moves
 // the liquid at sphere 1 by (3/4) x U_2 across the line of centres, so
 // Y^A_12 = -(3/4) x and, reflected back, Y^A_11 = 1 + (9/16) x^2; its rotlet
-// moves it by x^2 a W_2 x d (Y^B_12 = (3/2) x^2) and turns it at -(1/2) x^3
-// W_2 (Y^C_12 = (1/2) x^3); sphere 1's own rotlet, met by sphere 2 held
-// still, comes back as a Stokeslet whose vorticity turns the liquid at sphere
-// 1 by -(3/4) x^4 W_1 (Y^C_11 = 1 + (3/4) x^4).
+// moves it by x^2 a d x W_2 (Y^B_12 = (3/2) x^2) and turns it at -(1/2) x^3
+// W_2 (Y^C_12 = (1/2) x^3). What sphere 1 sends out comes back from sphere 2
+// held still as a Stokeslet, whose vorticity turns the liquid at sphere 1:
+// by (9/16) x^3 (U_1 x d) / a for sphere 1 translating (Y^B_11 = -(9/8) x^3),
+// by -(3/4) x^4 W_1 for it rotating (Y^C_11 = 1 + (3/4) x^4).
 TEST(TwoSphereTangential, FarApartIsTheFirstReflections) {
   const double xi = 18, x = 1 / (2 + xi);  // r = 20 a
   const auto y = equal_sphere_tangential_functions(xi);
   EXPECT_NEAR(y.YA12, -0.75 * x, 2 * std::pow(x, 3));
   EXPECT_NEAR(y.YA11, 1 + 9.0 / 16 * x * x, 4 * std::pow(x, 4));
   EXPECT_NEAR(y.YB12, 1.5 * x * x, 4 * std::pow(x, 4));
-  EXPECT_NEAR(y.YB11, 0, 2 * std::pow(x, 3));
+  EXPECT_NEAR(y.YB11, -9.0 / 8 * std::pow(x, 3), 4 * std::pow(x, 5));
   EXPECT_NEAR(y.YC12, 0.5 * x * x * x, 2 * std::pow(x, 5));
   EXPECT_NEAR(y.YC11, 1 + 0.75 * std::pow(x, 4), 8 * std::pow(x, 6));
 }
 
-// At contact, lubrication theory (O'Neill & Majumdar 1970; Jeffrey & Onishi's
-// coefficients at equal radii): sliding is resisted as ln(1/xi) / 3 (each
-// sphere's share 1/6), the torque it brings as -ln(1/xi) / 4; rolling, with
-// no slip across the gap, only as (3/20) ln(1/xi) in the torque, and its force
-// stays finite. Over a decade of xi near 1e-4 the O(xi ln xi) terms are below
-// 1e-3.
-TEST(TwoSphereTangential, ContactLogarithmsOfLubricationTheory) {
-  const double decade = std::log(10.0);
-  auto rise = [&](double (*f)(double)) { return f(1e-5) - f(1e-4); };
-  EXPECT_NEAR(rise(sliding_pair_force), decade / 3, 1e-3);
-  EXPECT_NEAR(rise(sliding_pair_torque), -decade / 4, 1e-3);
-  EXPECT_NEAR(rise(rolling_pair_torque), 3 * decade / 20, 1e-3);
-  EXPECT_NEAR(rise(rolling_pair_force), 0, 1e-3);
+// At contact, Townsend's near-field forms (lubrication theory's ln(1/xi) and
+// xi ln(1/xi) terms with the O(1) constants his own series gives, as
+// tabulated at s' = 2.00001 and 2.0001 in his stokesian-dynamics code): an
+// independent computation of the constants this series sums to, whose
+// neglected O(xi) terms are below 1e-5 here.
+constexpr Tabulated kTownsendNearContact[] = {
+    {1e-5, {2.91713802, -2.19247292, -2.63932618, 2.87662308, 3.00544095, 0.548189445}},
+    {1e-4, {2.53337384, -1.80870874, -2.06378065, 2.30107754, 2.54507545, 0.433110156}},
+};
+
+TEST(TwoSphereTangential, AtContactAgreesWithTownsendsNearFieldForms) {
+  for (const auto& w : kTownsendNearContact) {
+    const auto y = equal_sphere_tangential_functions(w.xi);
+    SCOPED_TRACE(w.xi);
+    EXPECT_NEAR(y.YA11, w.y.YA11, 1e-4);
+    EXPECT_NEAR(y.YA12, w.y.YA12, 1e-4);
+    EXPECT_NEAR(y.YB11, w.y.YB11, 1e-4);
+    EXPECT_NEAR(y.YB12, w.y.YB12, 1e-4);
+    EXPECT_NEAR(y.YC11, w.y.YC11, 1e-4);
+    EXPECT_NEAR(y.YC12, w.y.YC12, 1e-4);
+  }
 }
 
 // The modes are the functions' combinations: far apart a sliding or rolling
