@@ -38,6 +38,8 @@ def scheme_label(text):
         return "paper's method"
     if '1 dx apart, 1 sweep' in text:
         return 'one sweep'
+    if 'control forcing' in text:
+        return 'control forcing'
     return text
 
 
@@ -82,8 +84,8 @@ def main():
                 runs.extend(json.load(f)['runs'])
         except (OSError, ValueError, KeyError) as e:
             fail(f'{name}: not a bench_pair_tangential result ({e})')
-    order = {"paper's method": 0, 'one sweep': 1, 'partially saturated cells': 2}
-    runs.sort(key=lambda r: order.get(scheme_label(r['scheme']), 3))
+    order = {"paper's method": 0, 'one sweep': 1, 'control forcing': 2, 'partially saturated cells': 3}
+    runs.sort(key=lambda r: order.get(scheme_label(r['scheme']), 4))
     lines = tables(runs)
     if not args.check:
         print('\n'.join(lines))
