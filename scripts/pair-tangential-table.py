@@ -9,9 +9,10 @@ does for the normal approach), beside the exact pair's value, with the ratio in 
 Signs: the resisting components (the sliding force, the rolling torque) and the sliding torque
 are given as magnitudes; the rolling force as it acts (+y, pushed by the neighbour).
 
+--gaps S,... keeps only those gaps' rows (the offset is still read at the largest gap measured).
 --check DOC fails unless DOC holds each table whole, row for row.
 
-Usage: scripts/pair-tangential-table.py [--check DOC] RUN.json [RUN.json ...]"""
+Usage: scripts/pair-tangential-table.py [--gaps S,...] [--check DOC] RUN.json [RUN.json ...]"""
 import argparse
 import json
 import sys
@@ -43,8 +44,8 @@ def scheme_label(text):
     return text
 
 
-def tables(runs):
-    """Markdown lines of the four tables."""
+def tables(runs, shown=None):
+    """Markdown lines of the four tables (rows at the gaps in `shown`, or all)."""
     out = []
     for motion, key, title, sign in COMPONENTS:
         chosen = [r for r in runs if r['motion'] == motion]
@@ -65,6 +66,8 @@ def tables(runs):
             offset = measured[-1] - exact[-1]
             shares.append(([m - offset for m in measured], offset))
         for k, gap in enumerate(gaps):
+            if shown is not None and not any(abs(gap - g) < 1e-9 for g in shown):
+                continue
             cells = [f'{v[k]:.3f} ({v[k] / exact[k]:.2f})' for v, _ in shares]
             out.append(f'| {gap:g} | {exact[k]:.3f} | ' + ' | '.join(cells) + ' |')
         out.append('| offset | | ' + ' | '.join(f'{off:+.4f}' for _, off in shares) + ' |')
@@ -75,8 +78,15 @@ def tables(runs):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--check', metavar='DOC', help='fail unless DOC holds the tables, row for row')
+    parser.add_argument('--gaps', help='only the rows at these gaps s/a, comma-separated')
     parser.add_argument('runs', nargs='+', help="bench_pair_tangential's --json files")
     args = parser.parse_args()
+    shown = None
+    if args.gaps:
+        try:
+            shown = [float(g) for g in args.gaps.split(',')]
+        except ValueError:
+            fail(f'--gaps {args.gaps}: not a comma-separated list of numbers')
     runs = []
     for name in args.runs:
         try:
@@ -86,7 +96,7 @@ def main():
             fail(f'{name}: not a bench_pair_tangential result ({e})')
     order = {"paper's method": 0, 'one sweep': 1, 'control forcing': 2, 'partially saturated cells': 3}
     runs.sort(key=lambda r: order.get(scheme_label(r['scheme']), 4))
-    lines = tables(runs)
+    lines = tables(runs, shown)
     if not args.check:
         print('\n'.join(lines))
         return
