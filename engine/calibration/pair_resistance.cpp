@@ -105,6 +105,9 @@ class HeldPair {
         // need not cancel sliding's two forces exactly): a body force returns
         // their sum to the liquid, whose mean momentum a periodic box would
         // otherwise grow until the spheres' drag on the drift cancelled it.
+        // The radial motions' two forces cancel by the pair's symmetry, and
+        // they run as the shipped close-pair table was measured, so that
+        // `flocsim calibrate --close-pairs` reproduces it bit for bit.
         const spheres::Vec3 back = (coupling_->force()[0] + coupling_->force()[1]) /
                                    (static_cast<double>(box_) * (box_ / 2) * (box_ / 2));
         fluid_.set_body_force({back.x(), back.y(), back.z()});

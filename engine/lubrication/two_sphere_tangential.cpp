@@ -10,8 +10,10 @@ namespace flocsim::lubrication {
 namespace {
 
 // Highest power of t = 2a / r kept. The closed-form near-contact parts leave
-// coefficients that fall as 1/m^3, so the sum's tail at contact is about
-// 1e-5 (orders 150 and 250 differ by 2e-5 at most).
+// coefficients that fall as 1/m^3, so the truncation is felt only near
+// contact: order 100 against 200 differs by at most 4.4e-5 (at s = 1e-5 a),
+// 1.6e-5 at 0.02a and 3e-7 at 0.1a (measured by building this file with
+// kOrder = 200); order 200 takes 4 s to set up, order 100 0.2 s.
 constexpr int kOrder = 100;
 
 // Jeffrey & Onishi's twin-multipole coefficients P, Q, V(n, p, q) for equal
