@@ -1,5 +1,5 @@
-// A bonded pair sheared and rolled (docs/contacts.md, "A bonded pair sheared
-// and rolled (measured)"): the lattice's own resistance of two held spheres to the
+// A bonded pair sheared and rolled (docs/validation/bonded-pair.md): the
+// lattice's own resistance of two held spheres to the
 // tangential relative motions an aggregate's bonds make, per coupling scheme,
 // beside the exact creeping-flow values near contact. The close-pair
 // correction acts along the line of centres only, so this resistance is the
@@ -22,7 +22,7 @@
 // beside the same for the exact pair in unbounded liquid (Jeffrey & Onishi's
 // series, engine/lubrication/two_sphere_tangential.hpp). The measured values
 // include what the box's periodic images and the scheme's own radius for
-// rotation add; the table of docs/contacts.md removes it as the
+// rotation add; the study's tables remove it as the
 // measured-minus-exact at the largest gap (scripts/pair-tangential-table.py).
 #include <omp.h>
 
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
           "                      [--options OPTION,...] [--motions slide,roll]\n"
           "                      [--gaps S,...] [--json FILE]\n"
           "A held pair of spheres sliding and rolling, per coupling scheme, against the exact\n"
-          "pair (docs/contacts.md, \"A bonded pair sheared and rolled (measured)\"). OPTION: %s.\n",
+          "pair (docs/validation/bonded-pair.md). OPTION: %s.\n",
           bench::kOptionsSyntax);
       return 0;
     }

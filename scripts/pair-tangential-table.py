@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The tables of a bonded pair sheared and rolled (docs/contacts.md), from the JSON files
+"""The tables of a bonded pair sheared and rolled (docs/validation/bonded-pair.md), from the JSON files
 bench_pair_tangential wrote (one per coupling scheme, each holding its slide and roll runs).
 
 Per motion and component, each scheme's lattice share at every gap: the measured value less

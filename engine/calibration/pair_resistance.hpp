@@ -74,9 +74,9 @@ PairResistanceEntry calibrate_pair_resistance(
     const PairResistanceSettings& s, void (*progress)(const PairResistancePoint&) = nullptr);
 
 // The held pair's tangential relative motions, which a bonded pair in an
-// aggregate makes when it is sheared or rolled (docs/contacts.md, "A bonded
-// pair sheared and rolled (measured)"); only measured, not calibrated: the lubrication
-// correction acts along the line of centres only.
+// aggregate makes when it is sheared or rolled (docs/validation/bonded-pair.md);
+// only measured, not calibrated: the lubrication correction acts along the line
+// of centres only.
 //   slide: sphere 0 moves at +V along y, sphere 1 at -V, neither rotates: the
 //          facing surfaces slip past each other at 2V, the motion whose
 //          resistance grows as ln(a/s) at contact;

@@ -1,7 +1,7 @@
 #pragma once
 // The exact creeping-flow resistance of two equal spheres to motions across
 // their line of centres: the reference for a bonded pair sheared and rolled
-// (docs/contacts.md, "A bonded pair sheared and rolled (measured)").
+// (docs/validation/bonded-pair.md).
 //
 // Jeffrey & Onishi (1984, J. Fluid Mech. 139, 261) write the force and torque
 // on sphere 1 of a pair (unit vector d from sphere 1 to sphere 2, radius a)
