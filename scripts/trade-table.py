@@ -8,8 +8,9 @@ C_sph_err, n_a_mean, n_a_mean_err, Re_T, Re_T_err, max_liquid_speed_over_U_inf,
 max_liquid_Mach, coupling_worst_window, mass_balance_rel, momentum_balance_rel, steps, wall_s).
 A folder may also hold runs named U<U_inf>-<variant>-seed<seed> (say U0.07-papers-method-seed1):
 runs at that U_inf that differ from the trade's in one named way (another coupling method, say).
-Each variant is a group of its own, listed after the trade's runs and compared with the reference
-like another U_inf; a runs.csv holds the trade's own runs only.
+Each variant is a group of its own, listed after the trade's runs and compared with the trade's
+own runs at its U_inf, so that only the named way differs (a variant at a U_inf the trade has no
+runs at is refused); a runs.csv holds the trade's own runs only.
 
 First table, one row per run: F, U/U_inf, C_sph, <n_a>, Re_T with the batch-means error each run
 gives, the largest liquid speed in U_inf and its Mach number, and the coupling monitor's worst
@@ -19,7 +20,7 @@ Second table, one row per group (each U_inf of the trade, then each variant): th
 seeds, whose error is the larger of the seeds' scatter (sample standard deviation over sqrt(seeds))
 and the runs' combined batch errors (root of the sum of their squares over the number of seeds).
 Then the reference (the trade's own runs at the largest U_inf, the preset's, unless --reference
-names another) against each other group: the relative difference a/b - 1, its error (the ratio's:
+names another) against each other U_inf of the trade, and each variant's U_inf against the variant: the relative difference a/b - 1, its error (the ratio's:
 a/b times the two relative errors in quadrature), and in brackets |a/b - 1| in units of that error.
 Below: the balances and each run's steps and wall time.
 
@@ -111,8 +112,13 @@ def load(source):
             add((U_inf, ''), seed, run, where)
     else:
         fail(f"{source}: neither a folder of runs nor a runs.csv")
-    if len({U_inf for U_inf, variant in runs if not variant}) < 2:
+    own = {U_inf for U_inf, variant in runs if not variant}
+    if len(own) < 2:
         fail(f"{source}: a trade needs runs at two U_inf at least, found {sorted(label(g) for g in runs)}")
+    for U_inf, variant in runs:
+        if variant and U_inf not in own:
+            fail(f"{source}: the variant {label((U_inf, variant))} has no runs of the trade's own at U_inf "
+                 f"{U_inf:g} to be compared with (there are {sorted(label(g) for g in runs)})")
     seed_sets = {label(group): sorted(seeds) for group, seeds in runs.items()}
     if len(set(map(tuple, seed_sets.values()))) != 1:
         fail(f"{source}: the seeds differ between groups ({seed_sets}): the means would not compare")
@@ -173,8 +179,9 @@ def means_table(runs, reference):
                      ' | '.join(f"{m[key][0]:.{digits}f} +- {m[key][1]:.{digits}f}" for _, key, _, digits in FIGURES) +
                      ' |')
     for group in (g for g in means if g != reference):
-        cells = [difference_cell(*means[reference][key], *means[group][key]) for _, key, _, _ in FIGURES]
-        lines.append(f"| {label(reference)} against {label(group)} | " + ' | '.join(cells) + ' |')
+        base = (group[0], '') if group[1] else reference  # a variant against its own U_inf
+        cells = [difference_cell(*means[base][key], *means[group][key]) for _, key, _, _ in FIGURES]
+        lines.append(f"| {label(base)} against {label(group)} | " + ' | '.join(cells) + ' |')
     return lines
 
 
@@ -206,10 +213,7 @@ def main():
     parser.add_argument('source', metavar='SOURCE')
     args = parser.parse_args()
     runs = load(args.source)
-    plain = [U_inf for U_inf, variant in runs if not variant]
-    if not plain:
-        fail(f"{args.source}: no runs of the trade's own (U<U_inf>-seed<seed>), only variants: "
-             f"{sorted(label(g) for g in runs)}")
+    plain = [U_inf for U_inf, variant in runs if not variant]  # two at least: load() refuses fewer
     reference = (max(plain) if args.reference is None else args.reference, '')
     if reference not in runs:
         fail(f"--reference {args.reference}: no runs of the trade's own at that U_inf "

@@ -84,6 +84,24 @@ class TradeTable(unittest.TestCase):
         self.assertNotEqual(run.returncode, 0)
         self.assertIn('the seeds differ between groups', run.stderr)
 
+    def test_a_variant_is_compared_at_its_own_U_inf(self):
+        # 4.5 at 0.035 alt against the trade's 5.1 at 0.035 (not the reference 0.07): 5.1 / 4.5 - 1
+        # = +13.3 %; the error, the ratio's, 1.133 x hypot(0.3 / 5.1, 0.1 / 4.5) = 7.1 % (1.9)
+        write_run(self.dir / 'U0.07-seed1', 0.07, 1, 5.0, 0.1)
+        write_run(self.dir / 'U0.035-seed1', 0.035, 1, 5.1, 0.3)
+        write_run(self.dir / 'U0.035-alt-seed1', 0.035, 1, 4.5, 0.1)
+        run = trade_table(self.dir)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertIn('| 0.035 against 0.035 alt | +13.3 % +- 7.1 % (1.9) |', run.stdout)
+
+    def test_a_variant_without_the_trades_runs_at_its_U_inf_is_refused(self):
+        write_run(self.dir / 'U0.07-seed1', 0.07, 1, 5.0, 0.1)
+        write_run(self.dir / 'U0.035-seed1', 0.035, 1, 5.1, 0.3)
+        write_run(self.dir / 'U0.05-alt-seed1', 0.05, 1, 4.5, 0.1)
+        run = trade_table(self.dir)
+        self.assertNotEqual(run.returncode, 0)
+        self.assertIn("has no runs of the trade's own at U_inf 0.05", run.stderr)
+
 
 if __name__ == '__main__':
     unittest.main()
