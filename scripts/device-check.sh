@@ -6,8 +6,9 @@
 # paper's case against the fluid alone), the CPU fluid benchmark on that
 # machine's cores for the speed-up, and the fluid scene and the paper's case at
 # the paper's box size on the GPU and on the CPU, writing every figure into one
-# folder. Sized to finish in under 8 minutes, so a 15-minute device session
-# holds it and a rerun.
+# folder. Sized to finish in under 8 minutes when its tests pass (9-10 with the
+# reruns below, which only failures start), so a 15-minute device session
+# holds a passing check and the runs mode, or a failing check and its reruns.
 #
 # Time limits per step: 50 + 55 + 85 + 80 + 40 + 4 x 25 + 2 x 35 = 480 s at
 # most, each with 5 s more for a step that ignores SIGTERM (a hung kernel):
