@@ -204,6 +204,21 @@ TEST(GpuLattice, CheckpointResumesBitIdenticallyOnTheGpuAndOnTheCpu) {
   EXPECT_LE(largest_difference(slots_of(a), slots_of(saved)), kDoubleRoundOff1000);
 }
 
+// `flocsim run` on the shipped shear-wave example as a child process, with
+// `options`; its exit status. On the device machine the bundle's paths
+// replace the build's (scripts/device-check.sh sets both). This process holds
+// a context on the GPU (query_gpus, the tests before): it lets go of it first,
+// or in an exclusive compute mode the child would find the GPU taken.
+int run_shear_wave_example(const std::string& options) {
+  const char* exe = std::getenv("FLOCSIM_EXE") ? std::getenv("FLOCSIM_EXE") : FLOCSIM_EXE;
+  const char* source =
+      std::getenv("FLOCSIM_SOURCE_DIR") ? std::getenv("FLOCSIM_SOURCE_DIR") : FLOCSIM_SOURCE_DIR;
+  flocsim::gpu::release_gpus();
+  return std::system((std::string(exe) + " run " + source + "/examples/fluid_shear_wave.json " +
+                      options + " --quiet")
+                         .c_str());
+}
+
 TEST(GpuRun, FluidSceneRunsOnTheGpuAndRecordsIt) {
   // `flocsim run --device cuda` on the shipped shear-wave example: the
   // measured viscosity is the input's within 1 % (as on the CPU), and
@@ -211,18 +226,8 @@ TEST(GpuRun, FluidSceneRunsOnTheGpuAndRecordsIt) {
   namespace fs = std::filesystem;
   const fs::path out = fs::temp_directory_path() / ("flocsim-gpu-run-" + std::to_string(getpid()));
   fs::remove_all(out);
-  // on the device machine the bundle's paths replace the build's
-  // (scripts/device-check.sh sets both)
-  const char* exe = std::getenv("FLOCSIM_EXE") ? std::getenv("FLOCSIM_EXE") : FLOCSIM_EXE;
-  const char* source =
-      std::getenv("FLOCSIM_SOURCE_DIR") ? std::getenv("FLOCSIM_SOURCE_DIR") : FLOCSIM_SOURCE_DIR;
-  const std::string command = std::string(exe) + " run " + source +
-                              "/examples/fluid_shear_wave.json --out " + out.string() +
-                              " --device cuda --quiet";
-  // This process holds a context on the GPU (query_gpus, the tests before):
-  // in an exclusive compute mode the child would find the GPU taken.
-  flocsim::gpu::release_gpus();
-  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const std::string options = "--out " + out.string() + " --device cuda";
+  ASSERT_EQ(run_shear_wave_example(options), 0) << options;
   std::ifstream in(out / "result.json");
   const auto result = nlohmann::json::parse(in);
   EXPECT_EQ(result["device"]["kind"], "cuda");
@@ -238,18 +243,11 @@ TEST(GpuRun, AGpuCheckpointResumesOnTheCpu) {
   // the odd layout), resumed with --device cpu: the same final wave as a run
   // on the CPU throughout, to round-off
   namespace fs = std::filesystem;
-  const char* exe = std::getenv("FLOCSIM_EXE") ? std::getenv("FLOCSIM_EXE") : FLOCSIM_EXE;
-  const char* source =
-      std::getenv("FLOCSIM_SOURCE_DIR") ? std::getenv("FLOCSIM_SOURCE_DIR") : FLOCSIM_SOURCE_DIR;
-  const std::string example = std::string(source) + "/examples/fluid_shear_wave.json";
   const fs::path base =
       fs::temp_directory_path() / ("flocsim-gpu-resume-" + std::to_string(getpid()));
   fs::remove_all(base);
-  flocsim::gpu::release_gpus();  // the child's GPU, in an exclusive mode (above)
   const auto run = [&](const fs::path& out, const std::string& extra) {
-    return std::system(
-        (std::string(exe) + " run " + example + " --out " + out.string() + " --quiet " + extra)
-            .c_str());
+    return run_shear_wave_example("--out " + out.string() + " " + extra);
   };
   ASSERT_NE(run(base / "moved", "--device cuda --stop-after 1501"), 0);  // stopped: exit 3
   ASSERT_EQ(run(base / "moved", "--device cpu --resume"), 0);
