@@ -9,6 +9,7 @@
 // each other's changes. (A lock is shared with a child forked while it is
 // held, as any flock: fork before taking it.)
 #include <filesystem>
+#include <memory>
 
 namespace flocsim::output {
 
@@ -19,6 +20,12 @@ class FileLock {
   // made (a missing or read-only folder).
   explicit FileLock(const std::filesystem::path& path);
   ~FileLock();
+
+  // The lock of `path` if no other process holds it now, without waiting;
+  // nullptr where one does, with that holder's process id in *holder (0 where
+  // it cannot be read). Throws as the constructor does.
+  static std::unique_ptr<FileLock> try_lock(const std::filesystem::path& path,
+                                            long* holder = nullptr);
   FileLock(const FileLock&) = delete;
   FileLock& operator=(const FileLock&) = delete;
 
@@ -26,6 +33,10 @@ class FileLock {
   static std::filesystem::path lock_file(const std::filesystem::path& path);
 
  private:
+  // wait: block until the lock is free; otherwise held() tells whether it was
+  FileLock(const std::filesystem::path& path, bool wait);
+  bool held() const { return fd_ >= 0; }
+
   std::filesystem::path lock_path_;
   int fd_ = -1;
 };

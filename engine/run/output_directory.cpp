@@ -111,15 +111,50 @@ nlohmann::json completed_case(const fs::path& dir) {
 }
 }  // namespace
 
+namespace {
+// --out as a message shows it: cut short past 120 characters.
+std::string shown_path(const fs::path& dir) {
+  return dir.string().size() > 120 ? dir.string().substr(0, 120) + "..." : dir.string();
+}
+
+void require_directory(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw input::InputError(dir.string() +
+                            ": exists and is not a directory; --out must name a "
+                            "directory");
+}
+}  // namespace
+
+std::unique_ptr<output::FileLock> lock_output_directory(const fs::path& dir) {
+  require_directory(dir);
+  std::unique_ptr<output::FileLock> lock;
+  long holder = 0;
+  try {
+    fs::create_directories(dir);
+    lock = output::FileLock::try_lock(dir / "flocsim-run", &holder);
+  } catch (const std::exception& e) {
+    // a name too long, a folder not writable, a link where the lock goes
+    throw input::InputError("--out " + shown_path(dir) + ": cannot prepare the output directory (" +
+                            e.what() + ")");
+  }
+  if (!lock)
+    throw input::InputError(
+        "--out " + shown_path(dir) + ": another flocsim" +
+        (holder > 0 ? " (process " + std::to_string(holder) + ")" : std::string()) +
+        " is writing to this directory now; two runs in one directory would overwrite each "
+        "other's output, so wait for it to end (a --resume then goes on from its checkpoint) or "
+        "give this run another --out");
+  return lock;
+}
+
 StartMode prepare_output_directory(const fs::path& dir, bool resume,
                                    const nlohmann::json& case_json) {
   try {
     return prepare(dir, resume, case_json);
   } catch (const fs::filesystem_error& e) {
     // a name too long, a folder not writable: an input error, with the path cut short
-    const std::string shown =
-        dir.string().size() > 120 ? dir.string().substr(0, 120) + "..." : dir.string();
-    throw input::InputError("--out " + shown + ": cannot prepare the output directory (" +
+    throw input::InputError("--out " + shown_path(dir) + ": cannot prepare the output directory (" +
                             e.code().message() + ")");
   }
 }
@@ -160,11 +195,7 @@ fs::path free_name(const fs::path& path) {
 }
 
 StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_json) {
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw input::InputError(dir.string() +
-                            ": exists and is not a directory; --out must name a "
-                            "directory");
+  require_directory(dir);
   fs::create_directories(dir);
   refuse_links(dir);
   bool completed = fs::exists(dir / "result.json");

@@ -16,8 +16,11 @@
 //     is refused, and nothing in it is touched.
 // Refusals are input errors naming the file and the way out.
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+
+#include "engine/output/file_lock.hpp"
 
 #include "engine/run/run_log.hpp"
 #include "engine/run/run_types.hpp"
@@ -28,6 +31,14 @@ enum class StartMode { fresh, from_checkpoint, already_completed };
 
 // The file in an output directory that records which case's output it holds.
 inline constexpr const char* kRunRecord = "flocsim-run.json";
+
+// Makes the output directory (a path taken by a file is refused) and takes its
+// lock, held while the returned object lives: a second flocsim given the same
+// --out while this one runs (a fresh start or a --resume) is refused, naming
+// the process that holds it, before it reads or writes anything there. The
+// lock lives in DIR/.flocsim-run.lock, which the holder removes as it ends
+// (one killed leaves it, and the next run takes it over: the kernel let go).
+std::unique_ptr<output::FileLock> lock_output_directory(const std::filesystem::path& dir);
 
 // `case_json` is the canonical case (to_json()) of the run about to start.
 StartMode prepare_output_directory(const std::filesystem::path& dir, bool resume,

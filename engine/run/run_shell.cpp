@@ -22,6 +22,7 @@ const char* const kFlocsimVersion = FLOCSIM_VERSION;
 RunShell::RunShell(const RunOptions& options, const nlohmann::json& case_json,
                    const std::vector<std::string>& warnings, int threads)
     : options_(options),
+      out_lock_(lock_output_directory(options.out_dir)),
       start_(prepare_output_directory(options.out_dir, options.resume, case_json)),
       log_(options.out_dir / "run.log", options.quiet),
       checkpoint_(options.out_dir / "checkpoint.h5") {

@@ -74,6 +74,8 @@ class RunShell {
 
  private:
   RunOptions options_;
+  // held for the run's life, taken before the directory is read: one flocsim per --out
+  std::unique_ptr<output::FileLock> out_lock_;
   StartMode start_;
   RunLog log_;
   std::filesystem::path checkpoint_;

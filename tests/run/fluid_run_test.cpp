@@ -5,6 +5,7 @@
 #include "engine/run/fluid_run.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -18,6 +19,7 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/output/field_snapshots.hpp"
+#include "engine/output/file_lock.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/coupled_step.hpp"
@@ -181,6 +183,51 @@ TEST(FluidRun, AFreshStartNeverDiscardsACheckpointOrAResult) {
   EXPECT_EQ(again.outcome, RunOutcome::completed);
   EXPECT_EQ(again.result, done.result);
   EXPECT_EQ(fs::last_write_time(dir / "result.json"), before);
+  fs::remove_all(dir);
+}
+
+// Two runs given one --out would overwrite each other's output: while another
+// process holds the directory, a fresh start and a --resume are both refused,
+// naming that process, before anything in the directory is read or written;
+// once the holder is killed (no destructor runs, its lock file stays) the
+// next run takes the directory over, and a run that ends leaves no lock file.
+TEST(OutputDirectory, ASecondRunInTheSameDirectoryIsRefusedWhileTheFirstHoldsIt) {
+  const cases::FluidCase c = shear_wave_case("double");
+  const fs::path dir = fresh_dir("held");
+  fs::create_directories(dir);
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t holder = ::fork();
+  ASSERT_GE(holder, 0);
+  if (holder == 0) {  // the other flocsim: takes the lock, says so, waits to be killed
+    auto lock = output::FileLock::try_lock(dir / "flocsim-run");
+    const char ok = lock ? '1' : '0';
+    [[maybe_unused]] const ssize_t w = ::write(ready[1], &ok, 1);
+    for (;;) ::pause();
+  }
+  char ok = 0;
+  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
+  ASSERT_EQ(ok, '1');
+  for (const bool resume : {false, true}) {
+    try {
+      run_fluid_case(c, {dir, resume, true, 0});
+      ADD_FAILURE() << "a run into a held directory was not refused (resume " << resume << ")";
+    } catch (const input::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("another flocsim (process " + std::to_string(holder) +
+                                           ") is writing to this directory"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "run.log"));  // refused before the directory was touched
+  EXPECT_FALSE(fs::exists(dir / kRunRecord));
+  ::kill(holder, SIGKILL);
+  ::waitpid(holder, nullptr, 0);
+  EXPECT_TRUE(fs::exists(dir / ".flocsim-run.lock"));  // a killed holder leaves its file
+  EXPECT_EQ(run_fluid_case(c, {dir, false, true, 0}).outcome, RunOutcome::completed);
+  EXPECT_FALSE(fs::exists(dir / ".flocsim-run.lock"));
+  ::close(ready[0]);
+  ::close(ready[1]);
   fs::remove_all(dir);
 }
 
