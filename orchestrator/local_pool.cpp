@@ -429,6 +429,14 @@ PoolSummary run_pool(db::ResultsDb& db, const db::SweepRecord& sweep, const Pool
           state = RunState::kRefused;
           why = "case refused (exit " + std::to_string(process::kExitBadInput) + "): " + tail;
           break;
+        case process::kExitBusy:
+          // an earlier worker of this run still writes its folder (one whose
+          // orchestrator died, say): not the case's fault; a later resume
+          // retries once that worker has ended
+          state = RunState::kLost;
+          why = "its run folder is held by another flocsim still running (exit " +
+                std::to_string(process::kExitBusy) + "): " + tail;
+          break;
         case process::kExitInterrupted:
           state = RunState::kInterrupted;
           why = "stopped by a signal after writing a checkpoint (exit " +

@@ -10,6 +10,7 @@
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/fluid_run.hpp"
+#include "engine/run/output_directory.hpp"
 #include "engine/run/sphere_run.hpp"
 
 namespace flocsim::app {
@@ -88,6 +89,9 @@ int run_command(const RunArguments& a) {
   try {
     report = parsed.fluid_scene ? run::run_fluid_case(parsed.fluid, options)
                                 : run::run_sphere_case(parsed.spheres, options);
+  } catch (const run::OutputDirectoryBusy& e) {
+    std::fprintf(stderr, "flocsim run: %s\n", printable(e.what()).c_str());
+    return process::kExitBusy;
   } catch (const input::InputError& e) {
     std::fprintf(stderr, "flocsim run: input error: %s\n", printable(e.what()).c_str());
     return kExitBadInput;

@@ -139,7 +139,7 @@ std::unique_ptr<output::FileLock> lock_output_directory(const fs::path& dir) {
                             e.what() + ")");
   }
   if (!lock)
-    throw input::InputError(
+    throw OutputDirectoryBusy(
         "--out " + shown_path(dir) + ": another flocsim" +
         (holder > 0 ? " (process " + std::to_string(holder) + ")" : std::string()) +
         " is writing to this directory now; two runs in one directory would overwrite each "

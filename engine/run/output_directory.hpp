@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "engine/input/input_reader.hpp"
 #include "engine/output/file_lock.hpp"
 
 #include "engine/run/run_log.hpp"
@@ -31,6 +32,14 @@ enum class StartMode { fresh, from_checkpoint, already_completed };
 
 // The file in an output directory that records which case's output it holds.
 inline constexpr const char* kRunRecord = "flocsim-run.json";
+
+// The refusal of an output directory that another live flocsim holds: not a
+// fault of the case (exit 4, not 2), so an orchestrator retries the run later
+// instead of giving it up.
+class OutputDirectoryBusy : public input::InputError {
+ public:
+  using input::InputError::InputError;
+};
 
 // Makes the output directory (a path taken by a file is refused) and takes its
 // lock, held while the returned object lives: a second flocsim given the same

@@ -7,6 +7,7 @@
 //   "exit": 0,                       exit code at the end (0 writes result.json)
 //   "truncate": false,               write a cut-off result.json, then exit 0
 //   "refuse": false,                 exit 2 at once, as bad input
+//   "busy": false,                   exit 4 at once, as when another worker holds DIR
 //   "crash_at": -1,                  abort() at this step
 //   "hang_at": -1,                   stop heart-beating (but keep living) at this step
 //   "by_x": {"2": {...}} }           overrides of these fields for the run with x = 2
@@ -89,6 +90,10 @@ int main(int argc, char** argv) {
   if (fake.value("refuse", false)) {
     std::cerr << "case: fake.refuse = true: refused (allowed: false)\n";
     return 2;
+  }
+  if (fake.value("busy", false)) {
+    std::cerr << "--out " << dir << ": another flocsim (process 1) is writing to this directory now\n";
+    return 4;
   }
 
   long step = 0;

@@ -276,6 +276,23 @@ TEST_F(Orchestrator, RefusedCaseKeepsItsMessageAndIsNotRetried) {
       << db.runs().front().error;
 }
 
+// A worker refused because an earlier worker of the run still holds its folder
+// (exit 4) is not refused for good: the run is `lost`, and a resume retries it.
+TEST_F(Orchestrator, AWorkerFindingItsFolderHeldIsLostAndRetried) {
+  const t::Output o = t::run(launch(fake_sweep({1}, 2, 10, {{"busy", true}})));
+  EXPECT_EQ(o.code, 1);
+  EXPECT_EQ(statuses()[1], "lost");
+  {
+    ResultsDb db(db_, ResultsDb::Mode::kExisting);
+    EXPECT_NE(db.runs().front().error.find("held by another flocsim still running (exit 4)"),
+              std::string::npos)
+        << db.runs().front().error;
+  }
+  t::run(resume());
+  ResultsDb db(db_, ResultsDb::Mode::kExisting);
+  EXPECT_EQ(db.runs().front().attempts, 2);
+}
+
 TEST_F(Orchestrator, CrashingWorkerFailsWithItsSignal) {
   t::run(launch(fake_sweep({1}, 5, 10, {{"crash_at", 2}})));
   EXPECT_EQ(statuses()[1], "failed");
