@@ -91,8 +91,12 @@ void refuse_changed_grid(const db::SweepRecord& known, const SweepSpec& spec,
 
 }  // namespace
 
-Registered register_sweep(db::ResultsDb& db, const SweepSpec& spec, const std::string& runs_dir) {
+void refuse_changed_grid(db::ResultsDb& db, const SweepSpec& spec) {
   if (const auto known = db.find_sweep(spec.name)) refuse_changed_grid(*known, spec, db.path());
+}
+
+Registered register_sweep(db::ResultsDb& db, const SweepSpec& spec, const std::string& runs_dir) {
+  refuse_changed_grid(db, spec);
   const std::vector<RunPoint> points = expand(spec);
   nlohmann::json axes = nlohmann::json::array();
   for (const Axis& a : spec.axes) axes.push_back(a.path);

@@ -18,6 +18,10 @@ struct Registered {
   int runs = 0;
   db::ResultsDb::AddedRuns added;
 };
+// Throws input::InputError, naming the field, where `db` holds a sweep of this
+// name with another base or other axes (a sweep may only add axis values):
+// what register_sweep refuses, asked before any work.
+void refuse_changed_grid(db::ResultsDb& db, const SweepSpec& spec);
 // Records the sweep and its runs (one run directory per case id under
 // `runs_dir`); runs already known are reused, whatever their state.
 Registered register_sweep(db::ResultsDb& db, const SweepSpec& spec, const std::string& runs_dir);

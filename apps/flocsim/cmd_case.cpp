@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/flocsim/command_registry.hpp"
+#include "apps/flocsim/gpu_fit.hpp"
 #include "engine/case/case_fields.hpp"
 #include "engine/case/case_file.hpp"
 #include "engine/input/input_reader.hpp"
@@ -75,6 +76,8 @@ int explain_field(const CaseOptions& o) {
 int check_case(const CaseOptions& o) {
   try {
     const cases::ParsedCase parsed = cases::parse_case(input::read_json_file(o.file));
+    // what `flocsim run` refuses on this machine before any work: no usable GPU, or one too small
+    if (const std::string why = gpu_refusal(parsed); !why.empty()) throw input::InputError(why);
     const auto& warnings = parsed.fluid_scene ? parsed.fluid.warnings : parsed.spheres.warnings;
     for (const std::string& w : warnings) std::cerr << "flocsim case check: warning: " << w << "\n";
     const nlohmann::json resolved =

@@ -138,15 +138,27 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 
 // --device cuda is checked before anything is recorded or started: the build
 // and (local backend) this machine must have a GPU, and every point of the
-// grid that runs at all must be a case that runs on one. Returns what CUDA_VISIBLE_DEVICES
+// grid that runs at all must be a case that runs on one. Without --device, a
+// grid whose cases ask for "device": "cuda" themselves (flocsim's cases) is
+// checked the same way and then runs as with --device cuda (a GPU per worker,
+// or per Slurm task). Returns what CUDA_VISIBLE_DEVICES
 // names each GPU the local pool spreads its workers over by (none on the
 // CPU; on Slurm, which gives each task its own GPU, they go unused).
-std::vector<std::string> check_device(const SweepOptions& o,
-                                      const std::vector<orc::RunPoint>& points) {
+std::vector<std::string> check_device(SweepOptions& o, const std::vector<orc::RunPoint>& points,
+                                      bool flocsim_cases) {
+  const bool given = !o.device.empty();
+  if (!given && flocsim_cases)
+    for (const orc::RunPoint& p : points)
+      if (p.case_json.is_object() && p.case_json.contains("device") &&
+          p.case_json["device"] == "cuda") {
+        o.device = "cuda";
+        break;
+      }
   if (o.device != "cuda") return {};
+  const std::string asked = given ? "--device cuda" : "the grid's cases ask for device = \"cuda\"";
   const gpu::GpuQuery q = gpu::query_gpus();
   if (!gpu::built_with_cuda() || (o.backend == "local" && q.devices.empty()))
-    throw flocsim::input::InputError("--device cuda: " + q.why_none +
+    throw flocsim::input::InputError(asked + ": " + q.why_none +
                                      "; run on the CPU with --device cpu");
   for (const orc::RunPoint& p : points) {
     nlohmann::json c = p.case_json;
@@ -163,7 +175,7 @@ std::vector<std::string> check_device(const SweepOptions& o,
     try {
       cases::parse_case(c);
     } catch (const flocsim::input::InputError& e) {
-      throw flocsim::input::InputError("--device cuda: grid point " + p.point.dump() + ": " +
+      throw flocsim::input::InputError(asked + ": grid point " + p.point.dump() + ": " +
                                        e.what());
     }
   }
@@ -171,6 +183,74 @@ std::vector<std::string> check_device(const SweepOptions& o,
   for (const gpu::GpuDevice& d : q.devices) indices.push_back(d.index);
   gpu::release_gpus();  // the workers take them; this process runs nothing there
   return orc::visible_gpu_ids(std::getenv("CUDA_VISIBLE_DEVICES"), indices);
+}
+
+// A grid whose every point `flocsim run` would refuse (a misspelt axis, a
+// preset that does not exist) would be recorded, its workers refused, and its
+// name kept for that grid: refused here instead, before anything is recorded,
+// with the first point's reason. Points refused beside runnable ones are the
+// sweep's business (its plan lists them; their workers record the refusal).
+void refuse_an_unrunnable_grid(const std::vector<orc::RunPoint>& points) {
+  std::string first;
+  for (const orc::RunPoint& p : points) {
+    try {
+      cases::parse_case(p.case_json);
+      return;
+    } catch (const flocsim::input::InputError& e) {
+      if (first.empty()) first = "grid point " + p.point.dump() + ": " + e.what();
+    }
+  }
+  if (!points.empty())
+    throw flocsim::input::InputError("every point of the grid is refused, as `flocsim run` would "
+                                     "refuse it; the first: " + first);
+}
+
+// The folder the run folders go under: made now, or refused (exit 2) before
+// the database is made, so that no run is recorded with a folder it cannot have.
+// Returns the folders it made, deepest first (for unmake_runs_dir).
+std::vector<std::filesystem::path> make_runs_dir(const std::string& dir, bool given) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> made;
+  std::error_code ec;
+  for (fs::path p = fs::absolute(dir, ec).lexically_normal(); !ec && p.has_relative_path();
+       p = p.parent_path()) {
+    if (p.filename().empty()) continue;  // a trailing separator
+    std::error_code absent;
+    if (fs::exists(p, absent) || absent) break;
+    made.push_back(p);
+  }
+  ec.clear();
+  const std::string what = given ? "--runs-dir " + dir : "the run folders' " + dir + " (from --db)";
+  if (fs::exists(fs::symlink_status(dir, ec)) && !fs::is_directory(dir, ec))
+    throw flocsim::input::InputError(what + ": exists and is not a folder; give a folder");
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir) || ::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw flocsim::input::InputError(
+        what + ": cannot make or write a folder there (" +
+        (ec ? ec.message() : std::string(std::strerror(errno))) + "); give a writable folder");
+  return made;
+}
+
+// Takes back what make_runs_dir made for a launch refused after it: each
+// folder only while it is still empty.
+void unmake_runs_dir(const std::vector<std::filesystem::path>& made) {
+  std::error_code ec;
+  for (const auto& p : made)
+    if (std::filesystem::is_empty(p, ec) && !ec) std::filesystem::remove(p, ec);
+}
+
+// The database, with a file that cannot be one (a folder, a device, not
+// SQLite) refused as the input error it is (exit 2). A database this command
+// may not write now (read-only, a full disk) stays a failure (exit 1): the
+// file is right, the place is not.
+std::unique_ptr<db::ResultsDb> open_db(const std::string& path, db::ResultsDb::Mode mode) {
+  try {
+    return std::make_unique<db::ResultsDb>(path, mode);
+  } catch (const db::ReadOnlyDbError&) {
+    throw;
+  } catch (const db::DbError& e) {
+    throw flocsim::input::InputError(e.what());  // it names --db and the file
+  }
 }
 
 int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
@@ -352,10 +432,26 @@ const bool registered = register_command(
            if (*action == "launch") {
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
              // a grid refused here leaves no database file behind
-             const std::vector<std::string> gpus = check_device(*o, orc::expand(spec));
+             const std::vector<orc::RunPoint> points = orc::expand(spec);
+             // another --worker reads its cases its own way: only flocsim's are checked
+             const bool flocsim_cases = o->worker.empty() && !std::getenv("FLOCSIM_WORKER");
+             if (flocsim_cases) refuse_an_unrunnable_grid(points);
+             const std::vector<std::string> gpus = check_device(*o, points, flocsim_cases);
              check_worker(o->worker);
-             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kCreate);
-             if (o->worker.empty() && !std::getenv("FLOCSIM_WORKER")) {
+             const std::string runs_dir =
+                 o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
+             const auto made = make_runs_dir(runs_dir, !o->runs_dir.empty());
+             std::unique_ptr<db::ResultsDb> opened;
+             try {
+               opened = open_db(o->db_path, db::ResultsDb::Mode::kCreate);
+               // a grid changed under its name: refused before the plan times anything
+               orc::refuse_changed_grid(*opened, spec);
+             } catch (const flocsim::input::InputError&) {
+               unmake_runs_dir(made);
+               throw;
+             }
+             db::ResultsDb& db = *opened;
+             if (flocsim_cases) {
                // what it will cost, on one screen, before anything starts (asks
                // nothing); another --worker reads its cases its own way
                orc::PlanOptions p;
@@ -366,8 +462,6 @@ const bool registered = register_command(
                std::cout << std::flush;
              }
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
-             const std::string runs_dir =
-                 o->runs_dir.empty() ? orc::default_runs_dir(o->db_path) : o->runs_dir;
              const orc::Registered reg = orc::register_sweep(db, spec, runs_dir);
              std::cout << "sweep " << orc::printable(spec.name) << ": " << reg.runs << " runs ("
                        << reg.added.added << " new, " << reg.added.reused << " already in "
@@ -378,17 +472,19 @@ const bool registered = register_command(
            }
            if (*action == "resume") {
              check_worker(o->worker);
-             db::ResultsDb db(o->db_path, db::ResultsDb::Mode::kExisting);
+             const auto opened = open_db(o->db_path, db::ResultsDb::Mode::kExisting);
+             db::ResultsDb& db = *opened;
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
+             const bool flocsim_cases = o->worker.empty() && !std::getenv("FLOCSIM_WORKER");
              std::vector<orc::RunPoint> points;
-             if (!o->device.empty())
+             if (!o->device.empty() || flocsim_cases)
                for (const db::RunRecord& r : db.runs(sweep.id))
                  points.push_back({r.id, nlohmann::json::parse(r.case_json),
                                    r.point_json.empty()
                                        ? nlohmann::ordered_json::object()
                                        : nlohmann::ordered_json::parse(r.point_json)});
-             const std::vector<std::string> gpus = check_device(*o, points);
+             const std::vector<std::string> gpus = check_device(*o, points, flocsim_cases);
              return run_sweep(
                  *o, db, sweep,
                  {RunState::kPending, RunState::kInterrupted, RunState::kLost, RunState::kFailed},

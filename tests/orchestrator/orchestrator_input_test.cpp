@@ -385,6 +385,78 @@ TEST_F(Orchestrator, RelaunchingASweepNameWithAnotherBaseIsRefused) {
   EXPECT_EQ(statuses().size(), 3u);
 }
 
+// Audit of 2026-11-28: a grid whose every point `flocsim run` refuses (a
+// misspelt axis), a --runs-dir that cannot be made, a --db that cannot be a
+// database and a base asking for a GPU this machine lacks were recorded and
+// then failed, refused or got stuck (and kept the sweep's name for the bad
+// grid); a changed base was refused only after the plan had timed the case.
+// All are refused now (exit 2) before anything is recorded or timed.
+TEST_F(Orchestrator, LaunchRefusesWhatCannotRunBeforeRecordingOrTimingAnything) {
+  const std::string base = R"("base": {"scene": "fluid", "fluid": {"size": [8, 8, 8],
+                              "viscosity": 0.05}, "run": {"steps": 10}})";
+  const auto sweep_file = [&](const std::string& name, const std::string& text) {
+    t::write_text(dir_ / name, text);
+    return (dir_ / name).string();
+  };
+  const auto launch_flocsim = [&](const std::string& file, std::vector<std::string> more = {}) {
+    std::vector<std::string> cmd{"sweep", "launch", file, "--db", db_};
+    cmd.insert(cmd.end(), more.begin(), more.end());
+    return t::run(flocsim(cmd));
+  };
+  const std::string typo =
+      sweep_file("typo.json", R"({"name": "a", )" + base + R"(, "axes": {"fluid.viscositty": [0.1]}})");
+  t::Output o = launch_flocsim(typo);
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("every point of the grid is refused"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("did you mean fluid.viscosity?"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(db_));
+
+  const std::string ok =
+      sweep_file("ok.json", R"({"name": "ok", )" + base + R"(, "axes": {"fluid.viscosity": [0.1]}})");
+  o = launch_flocsim(ok, {"--runs-dir", typo});
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("--runs-dir " + typo + ": exists and is not a folder"), std::string::npos)
+      << o.out;
+  o = launch_flocsim(ok, {"--runs-dir", "/proc/flocsim-no-such/runs"});
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("cannot make or write a folder there"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(db_));
+  // a --db that is a folder: refused, and the run folders made for it taken back
+  o = t::run(flocsim({"sweep", "launch", ok, "--db", dir_.string(), "--runs-dir",
+                      (dir_ / "new" / "runs").string()}));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("is a directory"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(dir_ / "new"));
+
+  ASSERT_EQ(launch_flocsim(ok).code, 0);
+  const std::string changed = sweep_file(
+      "changed.json", R"({"name": "ok", "base": {"scene": "fluid", "fluid": {"size": [8, 8, 8],
+                          "viscosity": 0.05}, "run": {"steps": 20}}, "axes": {"fluid.viscosity": [0.1]}})");
+  o = launch_flocsim(changed);
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("was launched with base.run.steps = 10; this file has 20"), std::string::npos)
+      << o.out;
+  EXPECT_EQ(o.out.find("per step"), std::string::npos) << "timed before refusing:\n" << o.out;
+
+  if (flocsim::gpu::query_gpus().devices.empty()) {
+    const std::string cuda = sweep_file(
+        "cuda.json", R"({"name": "cu", "base": {"scene": "fluid", "device": "cuda", "fluid":
+                         {"size": [8, 8, 8], "viscosity": 0.05}, "run": {"steps": 10}},
+                         "axes": {"fluid.viscosity": [0.1]}})");
+    const std::string other_db = (dir_ / "cuda.sqlite").string();
+    o = t::run(flocsim({"sweep", "launch", cuda, "--db", other_db}));
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_NE(o.out.find("the grid's cases ask for device = \"cuda\""), std::string::npos) << o.out;
+    EXPECT_FALSE(fs::exists(other_db));
+    // and `case check` refuses such a case as `run` does
+    t::write_text(dir_ / "cuda-case.json",
+                  json::parse(t::read_text(dir_ / "cuda.json"))["base"].dump());
+    o = t::run(flocsim({"case", "check", (dir_ / "cuda-case.json").string()}));
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_NE(o.out.find("device = \"cuda\""), std::string::npos) << o.out;
+  }
+}
+
 TEST_F(Orchestrator, WhereRefusesTextAgainstANumber) {
   // 'x<abc' compared as text and returned every row
   ASSERT_EQ(t::run(launch(fake_sweep({1, 2}, 1, 1))).code, 0);
