@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include "engine/case/resolved_case.hpp"
@@ -29,6 +30,14 @@ Filter parse_filter(const std::string& text) {
         trim(f.field);
         trim(f.value);
         if (f.field.empty() || f.value.empty()) break;
+        // inf, nan, 1e999: a bound no stored value compares with sensibly
+        // (F<inf matched nothing: the relative tolerance of = became inf too)
+        char* end = nullptr;
+        const double bound = std::strtod(f.value.c_str(), &end);
+        if (end == f.value.c_str() + f.value.size() && !std::isfinite(bound))
+          throw InputError("--where \"" + text + "\": " + f.value +
+                           " is not a finite number; compare with a finite bound (every stored "
+                           "value is finite)");
         return f;
       }
     }

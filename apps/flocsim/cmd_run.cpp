@@ -5,9 +5,9 @@
 #include <cstdio>
 
 #include "apps/flocsim/command_registry.hpp"
+#include "apps/flocsim/gpu_fit.hpp"
 #include "engine/case/case_file.hpp"
 #include "engine/input/input_reader.hpp"
-#include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/fluid_run.hpp"
 #include "engine/run/output_directory.hpp"
@@ -41,43 +41,11 @@ int run_command(const RunArguments& a) {
                  named ? "" : file.c_str(), what.c_str());
     return kExitBadInput;
   }
-  // A GPU that is not there is found out now, before any output is written.
-  const bool on_gpu = parsed.fluid_scene ? parsed.fluid.device == cases::Device::cuda
-                                         : parsed.spheres.device == cases::Device::cuda;
-  if (on_gpu) {
-    const gpu::GpuQuery q = gpu::query_gpus();
-    if (q.devices.empty()) {
-      std::fprintf(stderr,
-                   "flocsim run: input error in %s: device = \"cuda\": %s; run on the CPU "
-                   "with --device cpu\n",
-                   printable(a.case_file).c_str(), printable(q.why_none).c_str());
-      return kExitBadInput;
-    }
-    // the populations must fit the GPU's free memory (the host mirror is
-    // checked with the case, against this machine's); the lattice takes its
-    // memory before any output too, should another process take it meanwhile
-    // (a sphere scene adds the 3-component force field the immersed boundary
-    // writes, or the 8 numbers per cell of partially saturated cells, and the
-    // byte per cell of the liquid averages' solid mask)
-    const double cells = static_cast<double>(
-        parsed.fluid_scene ? parsed.fluid.size.cells() : parsed.spheres.derived.box.cells());
-    const bool single = parsed.fluid_scene
-                            ? parsed.fluid.precision == cases::Precision::single_precision
-                            : parsed.spheres.numerics.single_precision;
-    const double per_cell = parsed.fluid_scene                                     ? 19.0
-                            : parsed.spheres.numerics.coupling.immersed_boundary() ? 22.0
-                                                                                   : 27.0;
-    const double bytes = per_cell * cells * (single ? 4 : 8) + (parsed.fluid_scene ? 0 : cells);
-    const double available = 0.9 * q.devices.front().free_gib * (1u << 30);
-    if (bytes > available) {
-      std::fprintf(stderr,
-                   "flocsim run: input error in %s: the lattice takes %.1f GiB on the GPU, "
-                   "more than 90 %% of the %.1f GiB free there (%s); use a smaller box, float "
-                   "precision, or --device cpu\n",
-                   printable(a.case_file).c_str(), bytes / (1u << 30), q.devices.front().free_gib,
-                   printable(q.devices.front().name).c_str());
-      return kExitBadInput;
-    }
+  // A GPU that is not there, or too small, is found out now, before any output is written.
+  if (const std::string why = gpu_refusal(parsed); !why.empty()) {
+    std::fprintf(stderr, "flocsim run: input error in %s: %s\n", printable(a.case_file).c_str(),
+                 printable(why).c_str());
+    return kExitBadInput;
   }
   process::install_stop_handlers(process::SecondSignal::ends_the_process);
   run::RunOptions options;
@@ -124,11 +92,13 @@ const bool registered = register_command(
                       "Stop after N steps as if SIGTERM arrived (checkpoint, exit 3); for tests")
            ->check(CLI::Validator(
                [](std::string& v) -> std::string {
-                 // a whole number of steps; CLI11's own range check would print
-                 // the range of long (19 digits) or of double (309)
+                 // a whole number of steps, at least one (0 would be the engine's
+                 // "no stop" and run the whole case); CLI11's own range check
+                 // would print the range of long (19 digits) or of double (309)
                  const bool digits = !v.empty() && v.size() <= 18 &&
-                                     v.find_first_not_of("0123456789") == std::string::npos;
-                 return digits ? std::string() : "must be a whole number of steps >= 0, got " + v;
+                                     v.find_first_not_of("0123456789") == std::string::npos &&
+                                     v.find_first_not_of('0') != std::string::npos;
+                 return digits ? std::string() : "must be a whole number of steps >= 1, got " + v;
                },
                "STEPS"));
        return [args] { return run_command(*args); };

@@ -317,9 +317,17 @@ TEST_F(Orchestrator, CommandLineMistakesAreNamed) {
   o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", (dir_ / "o").string(),
                       "--stop-after", "-1"}));
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.out.find("--stop-after: must be a whole number of steps >= 0, got -1"),
+  EXPECT_NE(o.out.find("--stop-after: must be a whole number of steps >= 1, got -1"),
             std::string::npos)
       << o.out;
+  // 0 ran the whole case (the engine's "no stop"); refused like any other non-step
+  o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", (dir_ / "o").string(),
+                      "--stop-after", "00"}));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.out.find("--stop-after: must be a whole number of steps >= 1, got 00"),
+            std::string::npos)
+      << o.out;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
   EXPECT_LT(o.out.size(), 300u);  // not the 309-digit range of double
   const std::string long_name = (dir_ / std::string(5000, 'x')).string();
   o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", long_name}));
@@ -468,6 +476,12 @@ TEST_F(Orchestrator, WhereRefusesTextAgainstANumber) {
   EXPECT_EQ(std::count(o.out.begin(), o.out.end(), '\n'), 2) << o.out;  // header + one run
   o = t::run(flocsim({"query", "--db", db_, "--where", "status=completed"}));
   EXPECT_EQ(o.code, 0) << o.out;  // text against a text column stays allowed
+  // F<inf matched nothing and F!=nan everything: non-finite bounds are refused
+  for (const std::string bound : {"x<inf", "x>-inf", "x<1e999", "x=nan", "x!=NaN"}) {
+    o = t::run(flocsim({"query", "--db", db_, "--where", bound}));
+    EXPECT_EQ(o.code, 2) << bound << ": " << o.out;
+    EXPECT_NE(o.out.find("is not a finite number"), std::string::npos) << o.out;
+  }
 }
 
 TEST_F(Orchestrator, AFileThatIsNotSqliteIsNamed) {
