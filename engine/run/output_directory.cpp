@@ -133,8 +133,12 @@ std::unique_ptr<output::FileLock> lock_output_directory(const fs::path& dir) {
   try {
     fs::create_directories(dir);
     lock = output::FileLock::try_lock(dir / "flocsim-run", &holder);
+  } catch (const fs::filesystem_error& e) {
+    // a name too long, a folder not writable: the reason, not the path again
+    throw input::InputError("--out " + shown_path(dir) + ": cannot prepare the output directory (" +
+                            e.code().message() + ")");
   } catch (const std::exception& e) {
-    // a name too long, a folder not writable, a link where the lock goes
+    // the lock file cannot be made (a link where it goes, say)
     throw input::InputError("--out " + shown_path(dir) + ": cannot prepare the output directory (" +
                             e.what() + ")");
   }
@@ -208,11 +212,14 @@ StartMode prepare(const fs::path& dir, bool resume, const nlohmann::json& case_j
     // completed" and then failing on it, the run could never be resumed.
     const std::string damage = damaged_result(dir / "result.json");
     if (!damage.empty()) {
-      if (!resume)
+      // --resume is advised only where it would be taken: a checkpoint or
+      // the run record says this case wrote the file
+      const bool ours = checkpoint || recorded_as(dir, case_json);
+      if (!resume && ours)
         throw input::InputError((dir / "result.json").string() + ": " + damage +
                                 "; continue this case with --resume (the file is set aside as " +
                                 kUnreadableResult + "), or use another --out directory");
-      if (!checkpoint && !recorded_as(dir, case_json))
+      if (!ours)
         throw input::InputError(
             (dir / "result.json").string() + ": " + damage + ", and neither a checkpoint nor " +
             (dir / kRunRecord).string() +

@@ -101,6 +101,10 @@ void ProgressReporter::set_steps_total(long steps_total) {
 }
 
 void ProgressReporter::report(long step, const std::string& extra) {
+  // a sphere scene's total is an estimate (stage 1 ends when the suspension
+  // is stationary): one overrun grows it, so that progress never reads above
+  // 100 % or a negative ETA
+  if (step > steps_total_) steps_total_ = step;
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const long done = step - first_step_;

@@ -376,6 +376,15 @@ TEST(OutputDirectory, AnUnreadableResultIsSetAsideAndTheRunGoesOn) {
   std::ofstream(foreign / "result.json") << "{";
   EXPECT_THROW(run_fluid_case(small_case(0.05), {foreign, true, true, 0}), input::InputError);
   EXPECT_EQ(text_of(foreign / "result.json"), "{");
+  // and a fresh start there is not told to use --resume, which would be refused as above
+  try {
+    run_fluid_case(small_case(0.05), {foreign, false, true, 0});
+    ADD_FAILURE() << "a fresh start went ahead over a user's unreadable result.json";
+  } catch (const input::InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("--resume"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("move it away"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(text_of(foreign / "result.json"), "{");
   fs::remove_all(o);
   fs::remove_all(foreign);
 }

@@ -4,11 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "engine/output/atomic_file.hpp"
 #include "engine/output/field_snapshots.hpp"
 #include "engine/output/hdf5_file.hpp"
+#include "engine/run/run_log.hpp"
 #include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::output {
@@ -27,6 +29,26 @@ TEST(AtomicFile, ReplacesContentWithoutLeavingTemporaries) {
   int files = 0;
   for (const auto& e : fs::directory_iterator(dir)) files += e.is_regular_file();
   EXPECT_EQ(files, 1);
+  fs::remove_all(dir);
+}
+
+// A sphere scene's step total is an estimate (stage 1 ends at stationarity):
+// a run that ran past it reported 100.4 % and a negative ETA in progress.json
+// (what `sweep status` shows). The total now grows to the steps done.
+TEST(Progress, ARunPastItsEstimatedTotalReadsOneHundredPercent) {
+  const fs::path dir = flocsim::testing::fresh_dir("progress");
+  fs::create_directories(dir);
+  run::RunLog log(dir / "run.log", true);
+  run::ProgressReporter progress(log, dir / "progress.json", 0, 2002, 0, 1e9);
+  progress.finish(1001);
+  auto read = [&] { return nlohmann::json::parse(std::ifstream(dir / "progress.json")); };
+  EXPECT_DOUBLE_EQ(read()["fraction"].get<double>(), 1001.0 / 2002);
+  progress.finish(2010);
+  const auto j = read();
+  EXPECT_EQ(j["step"], 2010);
+  EXPECT_EQ(j["steps_total"], 2010);
+  EXPECT_DOUBLE_EQ(j["fraction"].get<double>(), 1.0);
+  EXPECT_GE(j["eta_s"].get<double>(), 0.0);
   fs::remove_all(dir);
 }
 
