@@ -33,25 +33,23 @@ void write_file(const fs::path& p, const std::string& text) {
   output::write_file_atomically(p, text);
 }
 
-// Refuses, before any work, an --out folder in which a file or folder that
-// post writes is a symbolic link: post would write through it and overwrite
-// the link's target (gnuplot writes the figures itself, so a rename cannot
-// help there). The links are the user's: named, never removed.
-void refuse_links(const fs::path& out) {
-  auto is_link = [](const fs::path& p) {
+// Every place in --out that post writes and finds taken (a file, a folder or
+// a link by that name): the tables, the report and the figures folder at the
+// top, and inside figures/ PNG, PDF, data/*.dat, scripts/*.gp and their logs.
+std::vector<fs::path> taken_output_places(const fs::path& out) {
+  auto taken = [](const fs::path& p) {
     std::error_code ec;
-    return fs::is_symlink(fs::symlink_status(p, ec));
+    return fs::exists(fs::symlink_status(p, ec));
   };
   auto ends_with = [](const std::string& name, const std::string& tail) {
     return name.size() >= tail.size() &&
            name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
   };
-  std::vector<std::string> links;
+  std::vector<fs::path> places;
   for (const char* name : {"aggregation.csv", "aggregation.md", "aggregation.tex",
                            "non_aggregating.csv", "non_aggregating.md", "non_aggregating.tex",
                            "columns.md", "left_out.md", "report.html", "figures"})
-    if (is_link(out / name)) links.push_back((out / name).string());
-  // what the figures folder holds: PNG, PDF, data/*.dat, scripts/*.gp and their logs
+    if (taken(out / name)) places.push_back(out / name);
   const std::vector<std::pair<std::string, std::vector<std::string>>> folders = {
       {"figures", {".png", ".pdf"}},
       {"figures/data", {".dat"}},
@@ -59,23 +57,71 @@ void refuse_links(const fs::path& out) {
   for (const auto& [folder, tails] : folders) {
     const fs::path f = out / folder;
     std::error_code ec;
-    if (folder != "figures" && is_link(f)) links.push_back(f.string());
-    if (is_link(f) || !fs::is_directory(f, ec)) continue;
+    if (folder != "figures" && taken(f)) places.push_back(f);
+    if (fs::is_symlink(fs::symlink_status(f, ec)) || !fs::is_directory(f, ec)) continue;
     for (const auto& e : fs::directory_iterator(f, ec)) {
       const std::string name = e.path().filename().string();
-      if (!is_link(e.path())) continue;
       for (const std::string& tail : tails)
-        if (ends_with(name, tail)) links.push_back(e.path().string());
+        if (ends_with(name, tail)) places.push_back(e.path());
     }
   }
-  if (links.empty()) return;
+  return places;
+}
+
+std::string joined(const std::vector<std::string>& items) {
   std::string list;
-  for (const auto& l : links) list += (list.empty() ? "" : ", ") + l;
-  throw input::InputError("--out " + out.string() + ": " + list +
-                          (links.size() > 1 ? " are symbolic links" : " is a symbolic link") +
-                          " where flocsim post writes its output, which would overwrite what " +
-                          (links.size() > 1 ? "they point" : "it points") +
-                          " to; remove the link (flocsim does not) or use another --out folder");
+  for (const auto& l : items) list += (list.empty() ? "" : ", ") + l;
+  return list;
+}
+
+// What an --out folder says it holds: written by an earlier flocsim post.
+constexpr const char* kPostRecord = ".flocsim-post";
+
+// Makes --out ready before any work, or refuses it (exit 2):
+// - a path taken by a file, or a folder that cannot be made;
+// - a symbolic link where post writes: post would write through it and
+//   overwrite the link's target (gnuplot writes the figures itself, so a
+//   rename cannot help there); the links are the user's, named, never removed;
+// - files where post writes in a folder no earlier post wrote (no record):
+//   they are the user's (their own aggregation.csv, say), and post replaces
+//   only what it wrote. A folder with the record is post's to refresh.
+// Then records the folder as post's.
+void prepare_out(const fs::path& out) {
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(out, ec)) && !fs::is_directory(out, ec))
+    throw input::InputError("--out " + out.string() +
+                            ": exists and is not a folder; give a folder for the tables and figures");
+  const std::vector<fs::path> places = taken_output_places(out);
+  std::vector<std::string> links, files;
+  for (const fs::path& p : places) {
+    if (fs::is_symlink(fs::symlink_status(p, ec)))
+      links.push_back(p.string());
+    else if (!fs::is_directory(p, ec))
+      files.push_back(p.string());
+  }
+  if (!links.empty())
+    throw input::InputError("--out " + out.string() + ": " + joined(links) +
+                            (links.size() > 1 ? " are symbolic links" : " is a symbolic link") +
+                            " where flocsim post writes its output, which would overwrite what " +
+                            (links.size() > 1 ? "they point" : "it points") +
+                            " to; remove the link (flocsim does not) or use another --out folder");
+  if (!files.empty() && !fs::exists(out / kPostRecord, ec))
+    throw input::InputError(
+        "--out " + out.string() + ": " + joined(files) + (files.size() > 1 ? " are" : " is") +
+        " where flocsim post writes, and no earlier flocsim post wrote this folder (it has no " +
+        kPostRecord + "); post replaces only its own output, so move " +
+        (files.size() > 1 ? "them" : "it") + " away or use another --out folder");
+  fs::create_directories(out, ec);
+  if (!ec)
+    try {
+      write_file(out / kPostRecord,
+                 "This folder holds the output of flocsim post, which replaces it when run again.\n");
+    } catch (const std::exception& e) {
+      throw input::InputError("--out " + out.string() + ": cannot write there (" + e.what() + ")");
+    }
+  if (ec)
+    throw input::InputError("--out " + out.string() + ": cannot make the folder (" + ec.message() +
+                            ")");
 }
 
 // Writes the tables (CSV, Markdown, LaTeX) and prints the aggregation table:
@@ -117,6 +163,7 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const std::vector<std
               << " left out of the tables: " << printable((out / "left_out.md").string()) << "\n";
 }
 
+
 int post(const std::string& what, const PostOptions& o) {
   try {
     std::vector<orchestrator::Filter> where;
@@ -127,7 +174,6 @@ int post(const std::string& what, const PostOptions& o) {
       std::ostringstream unused;
       pp::write_aggregation_terminal({}, o.columns, o.all, 0, unused);
     }
-    refuse_links(fs::path(o.out_dir));
     // said before any work: without gnuplot there are no figures
     const std::string no_figures = what == "tables" ? "" : pp::why_no_figures();
     if (!no_figures.empty()) {
@@ -140,6 +186,7 @@ int post(const std::string& what, const PostOptions& o) {
                 << "; the tables and a report without figures are written\n";
     }
     db::ResultsDb db(o.db_path, db::ResultsDb::Mode::kReadOnly);
+    prepare_out(fs::path(o.out_dir));  // after the database: a --db refused leaves no folder
     std::vector<orchestrator::DamagedRun> damaged;
     const auto runs = pp::load_runs(
         db, o.sweep.empty() ? std::nullopt : std::optional<std::string>(o.sweep), where, &damaged);
@@ -149,7 +196,6 @@ int post(const std::string& what, const PostOptions& o) {
       std::cerr << "flocsim post: left out, unreadable: " << printable(d.text()) << "\n";
     }
     const fs::path out(o.out_dir);
-    fs::create_directories(out);
     if (what == "tables") {
       write_tables(runs, left_out, out, o);
     } else {

@@ -106,6 +106,40 @@ TEST_F(Post, SymbolicLinksWhereOutputGoesAreRefusedAndTheirTargetsKept) {
   EXPECT_EQ(t::read_text(target), "precious\n");
 }
 
+// Audit of 2026-11-28: post replaced a user's own aggregation.csv and
+// report.html in --out without a word, and an --out that is a file ended in a
+// raw filesystem error (exit 1). Files where post writes, in a folder no
+// earlier post wrote, are now refused before any work and kept; post's own
+// folder (its .flocsim-post record) is refreshed as before; an --out that is
+// a file is an input error.
+TEST_F(Post, AUsersFilesWherePostWritesAreRefusedAndKept) {
+  const std::string db = demo_db();
+  const fs::path out = dir_ / "mine";
+  fs::create_directories(out);
+  t::write_text(out / "aggregation.csv", "my own table\n");
+  t::write_text(out / "notes.txt", "notes\n");
+  const t::Output r = t::run(flocsim({"post", "tables", "--db", db, "--out", out.string()}));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_THAT(r.out, AllOf(HasSubstr((out / "aggregation.csv").string()),
+                           HasSubstr("no earlier flocsim post wrote this folder")));
+  EXPECT_EQ(t::read_text(out / "aggregation.csv"), "my own table\n");
+  EXPECT_FALSE(fs::exists(out / "aggregation.md")) << "work done before the refusal";
+  // a folder of post's own, with other files of the user's beside: written, then refreshed
+  const fs::path own = dir_ / "own";
+  fs::create_directories(own);
+  t::write_text(own / "notes.txt", "notes\n");
+  ASSERT_EQ(t::run(flocsim({"post", "tables", "--db", db, "--out", own.string()})).code, 0);
+  EXPECT_TRUE(fs::exists(own / ".flocsim-post"));
+  const t::Output again = t::run(flocsim({"post", "tables", "--db", db, "--out", own.string()}));
+  EXPECT_EQ(again.code, 0) << again.out;
+  EXPECT_EQ(t::read_text(own / "notes.txt"), "notes\n");
+  // --out naming a file
+  const t::Output file = t::run(
+      flocsim({"post", "tables", "--db", db, "--out", (own / "notes.txt").string()}));
+  EXPECT_EQ(file.code, 2) << file.out;
+  EXPECT_THAT(file.out, HasSubstr("exists and is not a folder"));
+}
+
 // Issue 41, item 16: `post report --columns bogus` was refused only after
 // every figure and table was written (and no report.html beside them).
 TEST_F(Post, AnUnknownColumnIsRefusedBeforeAnyWork) {
