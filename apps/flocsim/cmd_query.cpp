@@ -36,7 +36,8 @@ const bool registered = register_command(
        cmd.add_flag("--all", o->all,
                     "Every column, however wide (the table otherwise fits the terminal)");
        cmd.add_option("--format,-f", o->format, "Output format")
-           ->check(CLI::IsMember({"table", "csv", "json"}));
+           ->check(CLI::IsMember({"table", "csv", "json"}))
+           ->capture_default_str();
        return CommandHandler([o]() -> int {
          try {
            orc::QueryOptions q;

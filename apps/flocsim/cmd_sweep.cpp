@@ -42,6 +42,7 @@ struct SweepOptions {
   double lease_s = 60;
   double grace_s = 120;
   bool no_wait = false;
+  bool jobs_given = false;  // --jobs on the command line (the local pool's; Slurm has its own)
   int measure_steps = 3;
   double watch_s = 0;
   std::string plan_db;
@@ -253,6 +254,22 @@ std::unique_ptr<db::ResultsDb> open_db(const std::string& path, db::ResultsDb::M
   }
 }
 
+// Options that one backend would silently ignore are refused: --no-wait is
+// Slurm's (the local pool follows its workers itself), --jobs the local
+// pool's (Slurm runs the array's tasks as its queue allows; slurm.max_parallel
+// throttles them).
+void refuse_options_of_the_other_backend(const SweepOptions& o) {
+  if (o.no_wait && o.backend != "slurm")
+    throw flocsim::input::InputError(
+        "--no-wait: only with --backend slurm (the local pool follows its workers until they end; "
+        "stop it with Ctrl-C and continue with `flocsim sweep resume`)");
+  if (o.jobs_given && o.backend == "slurm")
+    throw flocsim::input::InputError(
+        "--jobs " + std::to_string(o.jobs) +
+        ": only for the local backend; Slurm runs the array's tasks as its queue allows (limit "
+        "them with the sweep file's slurm.max_parallel)");
+}
+
 int run_sweep(const SweepOptions& o, db::ResultsDb& db, const db::SweepRecord& sweep,
               std::vector<RunState> states, const std::vector<std::string>& gpu_ids) {
   if (o.backend == "slurm") {
@@ -320,15 +337,20 @@ int watch_status(db::ResultsDb& db, bool writable, const std::optional<std::stri
 
 void common_run_options(CLI::App& cmd, SweepOptions& o) {
   cmd.add_option("--jobs,-j", o.jobs, "Worker processes at once (local backend)")
-      ->check(CLI::Range(1, 4096));
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.jobs_given = true; });
   cmd.add_option("--backend", o.backend, "Where workers run")
-      ->check(CLI::IsMember({"local", "slurm"}));
+      ->check(CLI::IsMember({"local", "slurm"}))
+      ->capture_default_str();
   cmd.add_option("--lease", o.lease_s,
                  "Seconds without a heartbeat (progress.json) after which a worker is lost")
-      ->check(finite_number(5.0, 1e6));
+      ->check(finite_number(5.0, 1e6))
+      ->capture_default_str();
   cmd.add_option("--grace", o.grace_s,
                  "Seconds a stopping worker may take to write its checkpoint before it is killed")
-      ->check(finite_number(1.0, 1e6));
+      ->check(finite_number(1.0, 1e6))
+      ->capture_default_str();
   cmd.add_option("--worker", o.worker,
                  "Program run as `WORKER run CASE --out DIR` (default: this flocsim, or "
                  "$FLOCSIM_WORKER)");
@@ -351,15 +373,18 @@ const bool registered = register_command(
            "updates, memory and wall time, and the points that would be refused");
        plan->add_option("sweep", o->sweep_file, "Sweep file (JSON)")->required();
        plan->add_option("--jobs,-j", o->jobs, "Worker processes at once (local backend)")
-           ->check(CLI::Range(1, 4096));
+           ->check(CLI::Range(1, 4096))
+           ->capture_default_str();
        plan->add_option("--backend", o->backend, "Where workers would run")
-           ->check(CLI::IsMember({"local", "slurm"}));
+           ->check(CLI::IsMember({"local", "slurm"}))
+           ->capture_default_str();
        plan->add_option("--db", o->plan_db,
                         "A results database: completed runs of the same configuration give the "
                         "rate, and runs already complete there are not counted");
        plan->add_option("--measure-steps", o->measure_steps,
                         "Time steps of each configuration measured here (0: none)")
-           ->check(CLI::Range(0, 1000));
+           ->check(CLI::Range(0, 1000))
+           ->capture_default_str();
        plan->add_option("--gpu-rate", o->gpu_rate_files,
                         "Estimate on a GPU: the JSON files bench_fluid_gpu and bench_coupling_gpu "
                         "wrote there (scripts/device-check.sh writes both); configurations the "
@@ -430,6 +455,7 @@ const bool registered = register_command(
              return kExitOk;
            }
            if (*action == "launch") {
+             refuse_options_of_the_other_backend(*o);
              const orc::SweepSpec spec = orc::read_sweep_file(o->sweep_file);
              // a grid refused here leaves no database file behind
              const std::vector<orc::RunPoint> points = orc::expand(spec);
@@ -471,6 +497,7 @@ const bool registered = register_command(
                               {RunState::kPending, RunState::kInterrupted, RunState::kLost}, gpus);
            }
            if (*action == "resume") {
+             refuse_options_of_the_other_backend(*o);
              check_worker(o->worker);
              const auto opened = open_db(o->db_path, db::ResultsDb::Mode::kExisting);
              db::ResultsDb& db = *opened;

@@ -465,6 +465,24 @@ TEST_F(Orchestrator, LaunchRefusesWhatCannotRunBeforeRecordingOrTimingAnything) 
   }
 }
 
+// --no-wait with the local pool and --jobs with Slurm were accepted and
+// silently ignored; both are refused now, and --help gives the defaults.
+TEST_F(Orchestrator, AnOptionTheBackendWouldIgnoreIsRefused) {
+  const std::string sweep = fake_sweep({1}, 1, 1);
+  t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--no-wait", "--worker",
+                                FAKE_WORKER_EXE}));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("--no-wait: only with --backend slurm"), std::string::npos) << o.out;
+  o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--backend", "slurm", "--jobs", "4",
+                      "--worker", FAKE_WORKER_EXE}));
+  EXPECT_EQ(o.code, 2) << o.out;
+  EXPECT_NE(o.out.find("--jobs 4: only for the local backend"), std::string::npos) << o.out;
+  EXPECT_FALSE(fs::exists(db_));
+  o = t::run(flocsim({"sweep", "launch", "--help"}));
+  EXPECT_NE(o.out.find("=120"), std::string::npos) << o.out;  // --grace's default
+  EXPECT_NE(o.out.find("=60"), std::string::npos) << o.out;   // --lease's
+}
+
 TEST_F(Orchestrator, WhereRefusesTextAgainstANumber) {
   // 'x<abc' compared as text and returned every row
   ASSERT_EQ(t::run(launch(fake_sweep({1, 2}, 1, 1))).code, 0);
