@@ -236,6 +236,18 @@ int main(int argc, char** argv) {
   std::printf("%-64s %-6s %12s %12s %8s %8s\n", "option", "prec", "fluid MLUPS", "full MLUPS",
               "ratio", "+coupling ms");
   nlohmann::json all = nlohmann::json::array();
+  // rewritten after each option: a run stopped at its time limit (the device
+  // check's) keeps every figure measured so far ("complete": false)
+  const auto save = [&](bool complete) {
+    if (json_file.empty()) return;
+    const std::string tmp = json_file + ".tmp";
+    std::ofstream(tmp) << nlohmann::json{{"gpu", q.devices[0].name},
+                                         {"complete", complete},
+                                         {"results", all}}
+                              .dump(2)
+                       << "\n";
+    std::rename(tmp.c_str(), json_file.c_str());
+  };
   for (const auto& scheme : schemes)
     for (const std::string p : {"float", "double"}) {
       if (precision != "all" && precision != p) continue;
@@ -245,11 +257,9 @@ int main(int argc, char** argv) {
                   r["fluid_MLUPS"].get<double>(), r["full_step_MLUPS"].get<double>(),
                   100 * r["full_over_fluid"].get<double>(), r["coupling_ms"].get<double>());
       all.push_back(r);
+      save(false);
     }
   std::printf("target: full step >= 50 %% of the fluid alone (issue 39)\n");
-  if (!json_file.empty()) {
-    std::ofstream out(json_file);
-    out << nlohmann::json{{"gpu", q.devices[0].name}, {"results", all}}.dump(2) << "\n";
-  }
+  save(true);
   return 0;
 }

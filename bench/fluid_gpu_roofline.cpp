@@ -126,6 +126,16 @@ int main(int argc, char** argv) {
   std::printf("%-15s %-9s %-10s %10s %14s %12s\n", "size", "precision", "force", "MLUPS",
               "copy GB/s", "of roofline");
   nlohmann::json all = nlohmann::json::array();
+  // rewritten after each configuration: a run stopped at its time limit (the
+  // device check's) keeps every figure measured so far ("complete": false)
+  const auto save = [&](bool complete) {
+    if (json_file.empty()) return;
+    const std::string tmp = json_file + ".tmp";
+    std::ofstream(tmp) << nlohmann::json{{"gpu", d.name}, {"complete", complete}, {"figures", all}}
+                              .dump(2)
+                       << "\n";
+    std::rename(tmp.c_str(), json_file.c_str());
+  };
   for (const lattice::Extent& e : sizes)
     for (const bool double_precision : {false, true})
       for (const bool field : {false, true}) {
@@ -136,8 +146,8 @@ int main(int argc, char** argv) {
                     f["MLUPS"].get<double>(), f["copy_bandwidth_GBs"].get<double>(),
                     100 * f["fraction_of_copy_roofline"].get<double>());
         all.push_back(f);
+        save(false);
       }
-  if (!json_file.empty())
-    std::ofstream(json_file) << nlohmann::json{{"gpu", d.name}, {"figures", all}}.dump(2) << "\n";
+  save(true);
   return 0;
 }

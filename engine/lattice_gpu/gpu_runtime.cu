@@ -115,35 +115,42 @@ __global__ void copy_kernel(const double2* __restrict__ in, double2* __restrict_
 double measure_copy_bandwidth_gbs(std::size_t bytes, int reps) {
   if (reps < 1) throw std::invalid_argument("copy bandwidth: reps must be >= 1");
   const std::size_t n = bytes / sizeof(double2);
-  double2 *in = nullptr, *out = nullptr;
-  cuda_check(cudaMalloc(&in, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
-  cuda_check(cudaMalloc(&out, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
-  cuda_check(cudaMemset(in, 0, n * sizeof(double2)), "cudaMemset");
+  // everything this takes is given back however it ends (a failed call
+  // throws from the middle of the loop)
+  struct Held {
+    double2 *in = nullptr, *out = nullptr;
+    cudaEvent_t start = nullptr, stop = nullptr;
+    ~Held() {
+      if (start) cudaEventDestroy(start);
+      if (stop) cudaEventDestroy(stop);
+      cudaFree(in);
+      cudaFree(out);
+    }
+  } h;
+  cuda_check(cudaMalloc(&h.in, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
+  cuda_check(cudaMalloc(&h.out, n * sizeof(double2)), "cudaMalloc (copy benchmark)");
+  cuda_check(cudaMemset(h.in, 0, n * sizeof(double2)), "cudaMemset");
   int sms = 0;
   int device = 0;
   cuda_check(cudaGetDevice(&device), "cudaGetDevice");
   cuda_check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
              "device attribute");
   const int blocks = sms * 8, threads = 256;
-  cudaEvent_t start, stop;
-  cudaEventCreate(&start);
-  cudaEventCreate(&stop);
-  FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(in, out, n);  // warm-up
+  cuda_check(cudaEventCreate(&h.start), "cudaEventCreate (copy benchmark)");
+  cuda_check(cudaEventCreate(&h.stop), "cudaEventCreate (copy benchmark)");
+  FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(h.in, h.out, n);  // warm-up
   cuda_check(cudaGetLastError(), "launch of the copy benchmark");
   std::vector<double> rates;
   for (int r = 0; r < reps; ++r) {
-    cudaEventRecord(start);
-    FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(in, out, n);
-    cudaEventRecord(stop);
-    cuda_check(cudaEventSynchronize(stop), "copy benchmark");
+    cuda_check(cudaEventRecord(h.start), "cudaEventRecord (copy benchmark)");
+    FLOCSIM_LAUNCH(blocks, threads, 0, copy_kernel)(h.in, h.out, n);
+    cuda_check(cudaEventRecord(h.stop), "cudaEventRecord (copy benchmark)");
+    cuda_check(cudaEventSynchronize(h.stop), "copy benchmark");
     float ms = 0;
-    cudaEventElapsedTime(&ms, start, stop);
+    cuda_check(cudaEventElapsedTime(&ms, h.start, h.stop), "cudaEventElapsedTime (copy benchmark)");
+    if (!(ms > 0)) throw std::runtime_error("copy benchmark: the GPU's timer gave no time");
     rates.push_back(2.0 * n * sizeof(double2) / (ms * 1e-3) / 1e9);
   }
-  cudaEventDestroy(start);
-  cudaEventDestroy(stop);
-  cudaFree(in);
-  cudaFree(out);
   std::sort(rates.begin(), rates.end());
   return rates[rates.size() / 2];
 }
