@@ -69,13 +69,16 @@ void check_value(const FieldSpec& f, const nlohmann::json& v) {
         throw InputError(p + " = " + exact_number(v.get<double>()) + ": must be " +
                          f.range.describe());
       return;
-    case FieldType::integer:
-      if (!v.is_number_integer() ||
-          (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(LONG_MAX)))
-        throw InputError(p + " = " + shown(v) + ": must be an integer " + f.range.describe());
-      if (!f.range.contains(static_cast<double>(v.get<long>())))
+    case FieldType::integer: {
+      long x = 0;
+      if (v.is_number() && !f.range.contains(v.get<double>()))
+        throw InputError(p + " = " + shown(v) + ": must be " + f.range.describe());
+      if (!whole_number(v, x))
+        throw InputError(p + " = " + shown(v) + ": must be a whole number " + f.range.describe());
+      if (!f.range.contains(static_cast<double>(x)))
         throw InputError(p + " = " + shown(v) + ": must be " + f.range.describe());
       return;
+    }
     case FieldType::boolean:
       if (!v.is_boolean()) throw InputError(p + " = " + shown(v) + ": must be true or false");
       return;

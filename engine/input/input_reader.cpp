@@ -84,12 +84,12 @@ long InputReader::integer(const std::string& key, const Range& range,
     if (fallback) return *fallback;
     throw InputError(field(key) + " is missing: an integer " + range.describe() + " is required");
   }
-  if (!v->is_number_integer())
-    throw InputError(field(key) + " = " + shown(*v) + ": must be an integer " + range.describe());
-  // an unsigned value beyond the range of long would wrap: refuse it
-  if (v->is_number_unsigned() && v->get<unsigned long>() > static_cast<unsigned long>(LONG_MAX))
+  long x = 0;
+  if (v->is_number() && !range.contains(v->get<double>()))  // 1e20: out of range, not a fraction
     throw InputError(field(key) + " = " + shown(*v) + ": must be " + range.describe());
-  const long x = v->get<long>();
+  if (!whole_number(*v, x))
+    throw InputError(field(key) + " = " + shown(*v) + ": must be a whole number " +
+                     range.describe());
   if (!range.contains(static_cast<double>(x)))
     throw InputError(field(key) + " = " + std::to_string(x) + ": must be " + range.describe());
   return x;
@@ -326,6 +326,21 @@ nlohmann::json read_json_file(const std::string& filename) {
   const std::string text = read_input_text(filename);
   check_json_text(text, filename);
   return nlohmann::json::parse(text);
+}
+
+bool whole_number(const nlohmann::json& value, long& out) {
+  if (value.is_number_integer()) {
+    if (value.is_number_unsigned() &&
+        value.get<unsigned long>() > static_cast<unsigned long>(LONG_MAX))
+      return false;
+    out = value.get<long>();
+    return true;
+  }
+  if (!value.is_number_float()) return false;
+  const double x = value.get<double>();
+  if (!std::isfinite(x) || x != std::floor(x) || std::fabs(x) > 9007199254740992.0) return false;
+  out = static_cast<long>(x);
+  return true;
 }
 
 std::string shown(const nlohmann::json& value, std::size_t limit) {

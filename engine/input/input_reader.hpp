@@ -89,4 +89,10 @@ nlohmann::json read_json_file(const std::string& filename);
 // A JSON value as shown in a message: its text, cut to `limit` characters.
 std::string shown(const nlohmann::json& value, std::size_t limit = 80);
 
+// A whole number as JSON may write it: 2000, or 2000.0 and 2e3, which JSON
+// readers store as floating point (a sweep axis takes them as one number);
+// false for a fraction, a value beyond long, or one past 2^53, where a
+// double no longer holds every whole number exactly.
+bool whole_number(const nlohmann::json& value, long& out);
+
 }  // namespace flocsim::input

@@ -117,7 +117,7 @@ TEST(FluidCase, WrongTypesAreRefused) {
               AllOf(HasSubstr("fluid.viscosity"), HasSubstr("\"0.01\""), HasSubstr("number")));
   d = valid_case();
   d["run"]["steps"] = 10.5;
-  EXPECT_THAT(refusal(d), AllOf(HasSubstr("run.steps"), HasSubstr("integer")));
+  EXPECT_THAT(refusal(d), AllOf(HasSubstr("run.steps"), HasSubstr("whole number")));
   d = valid_case();
   d["precision"] = "quad";
   EXPECT_THAT(refusal(d), AllOf(HasSubstr("precision"), HasSubstr("\"float\"")));

@@ -119,6 +119,35 @@ TEST(InputFile, ALongValueIsShownCutShort) {
   }
 }
 
+// A whole number written as JSON allows (2000.0, 2e3, stored as floating
+// point by the reader) was refused as "1000.0: must be an integer", while a
+// sweep axis took 2000.0 as 2000. It is the same number now; a fraction is
+// refused as not whole, a value beyond the range by the range.
+TEST(InputFile, AWholeNumberWrittenWithAnExponentIsAnInteger) {
+  const nlohmann::json doc =
+      nlohmann::json::parse(R"({"a": 1e3, "b": 2000.0, "c": 7, "d": 1.5, "e": 1e20, "f": -0.0})");
+  InputReader in(doc, "run");
+  const Range steps{.at_least = 0, .at_most = 1e12};
+  EXPECT_EQ(in.integer("a", steps), 1000);
+  EXPECT_EQ(in.integer("b", steps), 2000);
+  EXPECT_EQ(in.integer("c", steps), 7);
+  EXPECT_EQ(in.integer("f", steps), 0);
+  const auto refusal = [&](const std::string& key) {
+    try {
+      in.integer(key, steps);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refusal("d"), "run.d = 1.5: must be a whole number >= 0 and <= 1e+12");
+  EXPECT_EQ(refusal("e"), "run.e = 1e+20: must be >= 0 and <= 1e+12");
+  long x = 0;
+  EXPECT_FALSE(whole_number(nlohmann::json(9007199254740994.0), x));  // past 2^53
+  EXPECT_TRUE(whole_number(nlohmann::json(9007199254740992.0), x));
+  EXPECT_EQ(x, 9007199254740992L);
+}
+
 TEST(InputFile, DirectoryAndMissingFileAreNamed) {
   const fs::path dir = write_file("adir", "");
   fs::remove(dir);
