@@ -315,6 +315,11 @@ std::string read_input_text(const std::string& filename) {
 }
 
 void check_json_text(const std::string& text, const std::string& origin) {
+  // the JSON reader takes a NUL byte for the end of its input, so whatever
+  // follows one was never read (`{...}\0junk` passed); JSON text holds none
+  if (const auto nul = text.find('\0'); nul != std::string::npos)
+    throw InputError(origin + ": a NUL byte at offset " + std::to_string(nul) +
+                     ", which JSON text never holds (a binary file, or one cut and pasted?)");
   JsonChecker checker(text);
   if (!nlohmann::json::sax_parse(text, &checker)) {
     if (checker.error.empty()) checker.error = "not valid JSON";

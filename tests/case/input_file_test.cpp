@@ -148,6 +148,15 @@ TEST(InputFile, AWholeNumberWrittenWithAnExponentIsAnInteger) {
   EXPECT_EQ(x, 9007199254740992L);
 }
 
+// The JSON reader stops at a NUL byte, so `{...}` NUL `junk` was read as the
+// valid part alone; a NUL byte anywhere is refused, with where it is.
+TEST(InputFile, ANulByteIsRefusedNotTakenForTheEnd) {
+  const fs::path f = write_file("nul.json", std::string("{\"scene\": \"fluid\"}\0junk", 23));
+  EXPECT_THAT(refusal_of_file(f), AllOf(HasSubstr("a NUL byte at offset 18"),
+                                        HasSubstr("JSON text never holds")));
+  fs::remove(f);
+}
+
 TEST(InputFile, DirectoryAndMissingFileAreNamed) {
   const fs::path dir = write_file("adir", "");
   fs::remove(dir);
