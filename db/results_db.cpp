@@ -216,13 +216,13 @@ void refuse_non_sqlite_file(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return;
   if (fs::is_directory(path, ec))
-    throw DbError(path + ": is a directory; --db must name a results database file");
+    throw NotADatabaseError(path + ": is a directory; --db must name a results database file");
   if (fs::file_size(path, ec) == 0 || ec) return;  // an empty file becomes a new database
   char header[16] = {};
   std::ifstream in(path, std::ios::binary);
   in.read(header, sizeof header);
   if (in.gcount() < 16 || std::memcmp(header, "SQLite format 3", 16) != 0)
-    throw DbError(path +
+    throw NotADatabaseError(path +
                   ": not an SQLite database (it does not start with the SQLite header); "
                   "--db must name a results database written by `flocsim sweep launch`");
 }
@@ -234,13 +234,14 @@ void refuse_non_sqlite_file(const std::string& path) {
 void check_db_path(const std::string& path, ResultsDb::Mode mode) {
   namespace fs = std::filesystem;
   if (path.empty())
-    throw DbError("--db \"\": an empty path; give a results database file (e.g. runs/demo.sqlite)");
+    throw NotADatabaseError(
+        "--db \"\": an empty path; give a results database file (e.g. runs/demo.sqlite)");
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {
     if (S_ISDIR(st.st_mode))
-      throw DbError(path + ": is a directory; --db must name a results database file");
+      throw NotADatabaseError(path + ": is a directory; --db must name a results database file");
     if (!S_ISREG(st.st_mode))
-      throw DbError(path +
+      throw NotADatabaseError(path +
                     ": not a regular file (a device, a pipe or a socket); --db must name a "
                     "results database file");
     return;
@@ -459,7 +460,7 @@ void ResultsDb::create_or_migrate() {
       Statement any(db_, "SELECT count(*) FROM sqlite_master");
       any.step();
       if (any.i64(0) != 0)
-        throw DbError(path_ + " is an SQLite file but not a flocsim results database");
+        throw NotADatabaseError(path_ + " is an SQLite file but not a flocsim results database");
       exec(schema_v1().c_str());
     }
     exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());

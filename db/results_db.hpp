@@ -28,6 +28,14 @@ class DbError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The --db path names something that cannot be a results database (an empty
+// path, a folder, a device, a file that is not SQLite, or another program's
+// SQLite file): bad input, where the other errors are failures of the place.
+class NotADatabaseError : public DbError {
+ public:
+  using DbError::DbError;
+};
+
 // A writer opened a database it may not write (a read-only file, folder or
 // file system). Readers open such a database with Mode::kReadOnly.
 class ReadOnlyDbError : public DbError {

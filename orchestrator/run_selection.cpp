@@ -30,14 +30,6 @@ Filter parse_filter(const std::string& text) {
         trim(f.field);
         trim(f.value);
         if (f.field.empty() || f.value.empty()) break;
-        // inf, nan, 1e999: a bound no stored value compares with sensibly
-        // (F<inf matched nothing: the relative tolerance of = became inf too)
-        char* end = nullptr;
-        const double bound = std::strtod(f.value.c_str(), &end);
-        if (end == f.value.c_str() + f.value.size() && !std::isfinite(bound))
-          throw InputError("--where \"" + text + "\": " + f.value +
-                           " is not a finite number; compare with a finite bound (every stored "
-                           "value is finite)");
         return f;
       }
     }
@@ -68,6 +60,13 @@ bool filter_matches(const json& v, const Filter& f) {
   if (v.is_null()) return false;
   double a = 0, b = 0;
   if (as_number(v, a) && as_number(json(f.value), b)) {
+    // inf, nan, 1e999 against a number: a bound no stored value compares with
+    // sensibly (F<inf matched nothing: the tolerance of = became inf too);
+    // against text ("sweep=inf") it stays a text comparison
+    if (!std::isfinite(b))
+      throw InputError("--where \"" + f.field + f.op + f.value + "\": " + f.value +
+                       " is not a finite number; compare " + f.field +
+                       " with a finite bound (every stored value is finite)");
     // Equality tolerates the last digits lost in printing (0.1+0.2 vs 0.3).
     const bool eq = std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b));
     if (f.op == "=") return eq;

@@ -350,7 +350,7 @@ for precision in float double; do
            "initial": {"type": "shear_wave", "amplitude": 0.02, "axis": "x", "component": "y"}},
  "run": {"steps": $steps, "progress_every_s": 10, "threads": 0}}
 CASE
-    step "run-paper-box-$precision-$device" 25 "${cpu_env[@]}" "$bin/flocsim" run \
+    step "run-paper-box-$precision-$device" 25 ${cpu_env[@]+"${cpu_env[@]}"} "$bin/flocsim" run \
       "$work/paper-box-$precision-$device.json" --out "$work/run-paper-box-$precision-$device" --quiet
   done
 done
@@ -367,7 +367,7 @@ for device in cuda cpu; do
   steps=1500 cpu_env=()
   [[ $device == cpu ]] && steps=30 cpu_env=(env -u OMP_WAIT_POLICY)
   ok_codes="0 3"  # a stop on request exits 3: that is this step's success
-  step "run-paper-case-$device" 35 "${cpu_env[@]}" "$bin/flocsim" run "$work/paper-case.json" \
+  step "run-paper-case-$device" 35 ${cpu_env[@]+"${cpu_env[@]}"} "$bin/flocsim" run "$work/paper-case.json" \
     --out "$work/run-paper-case-$device" --device "$device" --stop-after "$steps" --quiet
   ok_codes="0"
 done

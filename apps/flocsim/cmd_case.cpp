@@ -76,8 +76,13 @@ int explain_field(const CaseOptions& o) {
 int check_case(const CaseOptions& o) {
   try {
     const cases::ParsedCase parsed = cases::parse_case(input::read_json_file(o.file));
-    // what `flocsim run` refuses on this machine before any work: no usable GPU, or one too small
-    if (const std::string why = gpu_refusal(parsed); !why.empty()) throw input::InputError(why);
+    // what `flocsim run` would refuse on this machine (no usable GPU, or one
+    // too small) is said, not refused: a GPU case is often checked on a
+    // login node and run on a GPU node
+    if (const std::string why = gpu_refusal(parsed); !why.empty())
+      std::cerr << "flocsim case check: warning: `flocsim run` on this machine would refuse this "
+                   "case: "
+                << printable(why) << "\n";
     const auto& warnings = parsed.fluid_scene ? parsed.fluid.warnings : parsed.spheres.warnings;
     for (const std::string& w : warnings) std::cerr << "flocsim case check: warning: " << w << "\n";
     const nlohmann::json resolved =

@@ -108,9 +108,11 @@ void prepare_out(const fs::path& out) {
   if (!files.empty() && !fs::exists(out / kPostRecord, ec))
     throw input::InputError(
         "--out " + out.string() + ": " + joined(files) + (files.size() > 1 ? " are" : " is") +
-        " where flocsim post writes, and no earlier flocsim post wrote this folder (it has no " +
-        kPostRecord + "); post replaces only its own output, so move " +
-        (files.size() > 1 ? "them" : "it") + " away or use another --out folder");
+        " where flocsim post writes, and this folder has no " + kPostRecord +
+        " record of an earlier flocsim post; post replaces only its own output, so move " +
+        (files.size() > 1 ? "them" : "it") + " away or use another --out folder (a folder an " +
+        "earlier version of post wrote has no record: if these are post's, `touch " +
+        (out / kPostRecord).string() + "`)");
   fs::create_directories(out, ec);
   if (!ec)
     try {

@@ -1,7 +1,8 @@
 // flocsim run CASE.json --out DIR [--resume] [--quiet] [--device cpu|cuda]
 // One solver instance; also what the orchestrator's workers execute.
 // Exit codes: 0 completed, 1 failed, 2 input refused, 3 stopped by a signal
-// after writing a checkpoint (continue with --resume).
+// after writing a checkpoint (continue with --resume), 4 the output folder is
+// held by another live run (nothing done).
 #include <cstdio>
 
 #include "apps/flocsim/command_registry.hpp"

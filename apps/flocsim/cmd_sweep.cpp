@@ -140,22 +140,23 @@ db::SweepRecord pick_sweep(db::ResultsDb& db, const std::string& name) {
 // --device cuda is checked before anything is recorded or started: the build
 // and (local backend) this machine must have a GPU, and every point of the
 // grid that runs at all must be a case that runs on one. Without --device, a
-// grid whose cases ask for "device": "cuda" themselves (flocsim's cases) is
-// checked the same way and then runs as with --device cuda (a GPU per worker,
-// or per Slurm task). Returns what CUDA_VISIBLE_DEVICES
+// grid some of whose cases ask for "device": "cuda" themselves (flocsim's
+// cases) needs the GPU the same way; where all of them do it runs as with
+// --device cuda (a GPU per worker, or per Slurm task), and where only some do
+// (a device axis: the CPU against the GPU) each worker follows its case.
+// Returns what CUDA_VISIBLE_DEVICES
 // names each GPU the local pool spreads its workers over by (none on the
 // CPU; on Slurm, which gives each task its own GPU, they go unused).
 std::vector<std::string> check_device(SweepOptions& o, const std::vector<orc::RunPoint>& points,
                                       bool flocsim_cases) {
   const bool given = !o.device.empty();
+  int on_cuda = 0;
   if (!given && flocsim_cases)
     for (const orc::RunPoint& p : points)
-      if (p.case_json.is_object() && p.case_json.contains("device") &&
-          p.case_json["device"] == "cuda") {
-        o.device = "cuda";
-        break;
-      }
-  if (o.device != "cuda") return {};
+      on_cuda += p.case_json.is_object() && p.case_json.contains("device") &&
+                 p.case_json["device"] == "cuda";
+  if (!given && on_cuda > 0 && on_cuda == static_cast<int>(points.size())) o.device = "cuda";
+  if (o.device != "cuda" && on_cuda == 0) return {};
   const std::string asked = given ? "--device cuda" : "the grid's cases ask for device = \"cuda\"";
   const gpu::GpuQuery q = gpu::query_gpus();
   if (!gpu::built_with_cuda() || (o.backend == "local" && q.devices.empty()))
@@ -163,6 +164,9 @@ std::vector<std::string> check_device(SweepOptions& o, const std::vector<orc::Ru
                                      "; run on the CPU with --device cpu");
   for (const orc::RunPoint& p : points) {
     nlohmann::json c = p.case_json;
+    // with no --device, a point left on the CPU by its own case is the CPU's
+    if (o.device != "cuda" && !(c.is_object() && c.contains("device") && c["device"] == "cuda"))
+      continue;
     // a point refused on every device (below a stability floor, say) is the
     // sweep's business as without --device: its worker records the refusal.
     // Only what cuda alone cannot run stops the launch here.
@@ -186,16 +190,28 @@ std::vector<std::string> check_device(SweepOptions& o, const std::vector<orc::Ru
   return orc::visible_gpu_ids(std::getenv("CUDA_VISIBLE_DEVICES"), indices);
 }
 
+// Whether the workers are this flocsim, reading flocsim's cases: another
+// --worker (or $FLOCSIM_WORKER) reads its cases its own way, so neither the
+// plan nor the checks of a case apply to them.
+bool reads_flocsim_cases(const SweepOptions& o) {
+  return o.worker.empty() && !std::getenv("FLOCSIM_WORKER");
+}
+
 // A grid whose every point `flocsim run` would refuse (a misspelt axis, a
 // preset that does not exist) would be recorded, its workers refused, and its
 // name kept for that grid: refused here instead, before anything is recorded,
 // with the first point's reason. Points refused beside runnable ones are the
 // sweep's business (its plan lists them; their workers record the refusal).
-void refuse_an_unrunnable_grid(const std::vector<orc::RunPoint>& points) {
+// Asked on the local backend only: a case is also checked against this
+// machine's memory, and a Slurm sweep's login node is not where it runs.
+void refuse_an_unrunnable_grid(const std::vector<orc::RunPoint>& points,
+                                const std::string& device) {
   std::string first;
   for (const orc::RunPoint& p : points) {
     try {
-      cases::parse_case(p.case_json);
+      nlohmann::json c = p.case_json;
+      if (!device.empty() && c.is_object()) c["device"] = device;  // as the workers will get it
+      cases::parse_case(c);
       return;
     } catch (const flocsim::input::InputError& e) {
       if (first.empty()) first = "grid point " + p.point.dump() + ": " + e.what();
@@ -225,10 +241,18 @@ std::vector<std::filesystem::path> make_runs_dir(const std::string& dir, bool gi
   if (fs::exists(fs::symlink_status(dir, ec)) && !fs::is_directory(dir, ec))
     throw flocsim::input::InputError(what + ": exists and is not a folder; give a folder");
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir) || ::access(dir.c_str(), W_OK | X_OK) != 0)
-    throw flocsim::input::InputError(
-        what + ": cannot make or write a folder there (" +
-        (ec ? ec.message() : std::string(std::strerror(errno))) + "); give a writable folder");
+  int err = ec ? ec.value() : 0;
+  if (!err && !fs::is_directory(dir)) err = ENOTDIR;
+  if (!err && ::access(dir.c_str(), W_OK | X_OK) != 0) err = errno;
+  if (err) {
+    const std::string text = what + ": cannot make or write a folder there (" +
+                             std::strerror(err) + "); give a writable folder";
+    // a read-only or full file system, or one refused to this user, is the
+    // place failing (exit 1, as for the database); anything else is the path
+    if (err == EROFS || err == ENOSPC || err == EDQUOT || err == EACCES || err == EPERM)
+      throw std::runtime_error(text);
+    throw flocsim::input::InputError(text);
+  }
   return made;
 }
 
@@ -240,16 +264,14 @@ void unmake_runs_dir(const std::vector<std::filesystem::path>& made) {
     if (std::filesystem::is_empty(p, ec) && !ec) std::filesystem::remove(p, ec);
 }
 
-// The database, with a file that cannot be one (a folder, a device, not
-// SQLite) refused as the input error it is (exit 2). A database this command
-// may not write now (read-only, a full disk) stays a failure (exit 1): the
-// file is right, the place is not.
+// The database, with a path that cannot be one (a folder, a device, a file
+// that is not SQLite or not flocsim's) refused as the input error it is (exit
+// 2). Where the place fails (read-only, full, locked, a network file system
+// without WAL) it stays a failure (exit 1).
 std::unique_ptr<db::ResultsDb> open_db(const std::string& path, db::ResultsDb::Mode mode) {
   try {
     return std::make_unique<db::ResultsDb>(path, mode);
-  } catch (const db::ReadOnlyDbError&) {
-    throw;
-  } catch (const db::DbError& e) {
+  } catch (const db::NotADatabaseError& e) {
     throw flocsim::input::InputError(e.what());  // it names --db and the file
   }
 }
@@ -460,8 +482,8 @@ const bool registered = register_command(
              // a grid refused here leaves no database file behind
              const std::vector<orc::RunPoint> points = orc::expand(spec);
              // another --worker reads its cases its own way: only flocsim's are checked
-             const bool flocsim_cases = o->worker.empty() && !std::getenv("FLOCSIM_WORKER");
-             if (flocsim_cases) refuse_an_unrunnable_grid(points);
+             const bool flocsim_cases = reads_flocsim_cases(*o);
+             if (flocsim_cases && o->backend == "local") refuse_an_unrunnable_grid(points, o->device);
              const std::vector<std::string> gpus = check_device(*o, points, flocsim_cases);
              check_worker(o->worker);
              const std::string runs_dir =
@@ -472,7 +494,7 @@ const bool registered = register_command(
                opened = open_db(o->db_path, db::ResultsDb::Mode::kCreate);
                // a grid changed under its name: refused before the plan times anything
                orc::refuse_changed_grid(*opened, spec);
-             } catch (const flocsim::input::InputError&) {
+             } catch (...) {
                unmake_runs_dir(made);
                throw;
              }
@@ -503,7 +525,7 @@ const bool registered = register_command(
              db::ResultsDb& db = *opened;
              orc::reconcile_lost_workers(db, o->lease_s, &std::cout);
              const db::SweepRecord sweep = pick_sweep(db, o->sweep_name);
-             const bool flocsim_cases = o->worker.empty() && !std::getenv("FLOCSIM_WORKER");
+             const bool flocsim_cases = reads_flocsim_cases(*o);
              std::vector<orc::RunPoint> points;
              if (!o->device.empty() || flocsim_cases)
                for (const db::RunRecord& r : db.runs(sweep.id))
@@ -564,6 +586,10 @@ const bool registered = register_command(
            std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitBadInput;
          } catch (const db::DbError& e) {
+           std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
+           return kExitFailure;
+         } catch (const std::runtime_error& e) {
+           // the place failing (make_runs_dir: a read-only or full file system)
            std::cerr << "flocsim sweep: " << printable(e.what()) << "\n";
            return kExitFailure;
          }

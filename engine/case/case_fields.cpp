@@ -86,7 +86,7 @@ void add_physics_fields(std::vector<FieldSpec>& t) {
                .range = {.above = 0, .at_most = 0.35, .why = "(random placement jams near 0.38)"},
                .default_rule = "required (fixed-array: or positions_from)",
                .contexts = kManySpheres,
-               .unused = "has one sphere (single-sphere) or none (fluid)",
+               .unused = "places no spheres by a solids fraction",
                .doc = "solids fraction",
                .rules = "each coupling scheme's validated phi (one sweep, control forcing, "
                         "partially saturated cells: 0.2)"});

@@ -31,7 +31,10 @@ FileLock::FileLock(const std::filesystem::path& path, bool wait) : lock_path_(lo
       throw std::runtime_error("cannot lock " + path.string() + " (" + lock_path_.string() +
                                "): " + std::strerror(errno));
     while (::flock(fd_, wait ? LOCK_EX : LOCK_EX | LOCK_NB) != 0) {
-      if (!wait && errno == EWOULDBLOCK) {
+      const bool no_locks_here = errno == ENOLCK || errno == ENOSYS || errno == EOPNOTSUPP ||
+                                 errno == EINVAL;
+      if (!wait && (errno == EWOULDBLOCK || no_locks_here)) {
+        unsupported_ = no_locks_here;
         ::close(fd_);
         fd_ = -1;
         return;
@@ -61,6 +64,10 @@ FileLock::FileLock(const std::filesystem::path& path, bool wait) : lock_path_(lo
 std::unique_ptr<FileLock> FileLock::try_lock(const std::filesystem::path& path, long* holder) {
   std::unique_ptr<FileLock> lock(new FileLock(path, false));
   if (lock->held()) return lock;
+  if (lock->unsupported_) {
+    if (holder) *holder = -1;
+    return nullptr;
+  }
   if (holder) {
     *holder = 0;
     std::ifstream in(lock_file(path));

@@ -23,7 +23,8 @@ class FileLock {
 
   // The lock of `path` if no other process holds it now, without waiting;
   // nullptr where one does, with that holder's process id in *holder (0 where
-  // it cannot be read). Throws as the constructor does.
+  // it cannot be read), or where the file system offers no locks (some NFS,
+  // Lustre and FUSE mounts), with *holder = -1. Throws as the constructor does.
   static std::unique_ptr<FileLock> try_lock(const std::filesystem::path& path,
                                             long* holder = nullptr);
   FileLock(const FileLock&) = delete;
@@ -36,6 +37,7 @@ class FileLock {
   // wait: block until the lock is free; otherwise held() tells whether it was
   FileLock(const std::filesystem::path& path, bool wait);
   bool held() const { return fd_ >= 0; }
+  bool unsupported_ = false;  // flock refused by the file system itself
 
   std::filesystem::path lock_path_;
   int fd_ = -1;

@@ -142,6 +142,7 @@ std::unique_ptr<output::FileLock> lock_output_directory(const fs::path& dir) {
     throw input::InputError("--out " + shown_path(dir) + ": cannot prepare the output directory (" +
                             e.what() + ")");
   }
+  if (!lock && holder == -1) return nullptr;  // no locks on this file system: said in the log
   if (!lock)
     throw OutputDirectoryBusy(
         "--out " + shown_path(dir) + ": another flocsim" +

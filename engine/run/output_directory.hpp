@@ -47,6 +47,8 @@ class OutputDirectoryBusy : public input::InputError {
 // the process that holds it, before it reads or writes anything there. The
 // lock lives in DIR/.flocsim-run.lock, which the holder removes as it ends
 // (one killed leaves it, and the next run takes it over: the kernel let go).
+// nullptr where the file system offers no locks (the run goes on unguarded,
+// and says so in its log).
 std::unique_ptr<output::FileLock> lock_output_directory(const std::filesystem::path& dir);
 
 // `case_json` is the canonical case (to_json()) of the run about to start.

@@ -93,14 +93,14 @@ void ProgressReporter::update(long step, const std::string& extra) {
 }
 
 void ProgressReporter::finish(long step) {
-  report(step, "");
+  report(step, "", true);
 }
 
 void ProgressReporter::set_steps_total(long steps_total) {
   steps_total_ = steps_total;
 }
 
-void ProgressReporter::report(long step, const std::string& extra) {
+void ProgressReporter::report(long step, const std::string& extra, bool last) {
   // a sphere scene's total is an estimate (stage 1 ends when the suspension
   // is stationary): one overrun grows it, so that progress never reads above
   // 100 % or a negative ETA
@@ -112,8 +112,7 @@ void ProgressReporter::report(long step, const std::string& extra) {
   const double eta = rate > 0 ? (steps_total_ - step) / rate : INFINITY;
   const double fraction = steps_total_ > 0 ? static_cast<double>(step) / steps_total_ : 1.0;
   const double m = mlups(step);
-  if (std::chrono::duration<double>(now - last_print_).count() >= every_s_ ||
-      step == steps_total_) {
+  if (std::chrono::duration<double>(now - last_print_).count() >= every_s_ || last) {
     char line[256];
     char rate_text[32] = "";
     if (cells_ > 0) std::snprintf(rate_text, sizeof rate_text, " | %7.1f MLUPS", m);

@@ -56,7 +56,8 @@ class ProgressReporter {
   double mlups(long step) const;
 
  private:
-  void report(long step, const std::string& extra);
+  // last: the final report, printed whatever the cadence
+  void report(long step, const std::string& extra, bool last = false);
   RunLog& log_;
   std::filesystem::path progress_json_;
   long first_step_, steps_total_, cells_;

@@ -27,6 +27,10 @@ RunShell::RunShell(const RunOptions& options, const nlohmann::json& case_json,
       log_(options.out_dir / "run.log", options.quiet),
       checkpoint_(options.out_dir / "checkpoint.h5") {
   if (start_ != StartMode::already_completed) {
+    if (!out_lock_)
+      log_.warning("the file system under " + options.out_dir.string() +
+                   " offers no file locks: a second flocsim run given this folder while this one "
+                   "runs would not be refused");
     for (const auto& w : warnings) log_.warning(w);
     if (threads > 0) omp_set_num_threads(threads);
   }

@@ -121,7 +121,7 @@ TEST_F(Post, AUsersFilesWherePostWritesAreRefusedAndKept) {
   const t::Output r = t::run(flocsim({"post", "tables", "--db", db, "--out", out.string()}));
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_THAT(r.out, AllOf(HasSubstr((out / "aggregation.csv").string()),
-                           HasSubstr("no earlier flocsim post wrote this folder")));
+                           HasSubstr("record of an earlier flocsim post")));
   EXPECT_EQ(t::read_text(out / "aggregation.csv"), "my own table\n");
   EXPECT_FALSE(fs::exists(out / "aggregation.md")) << "work done before the refusal";
   // a folder of post's own, with other files of the user's beside: written, then refreshed

@@ -212,7 +212,7 @@ TEST(OutputDirectory, ASecondRunInTheSameDirectoryIsRefusedWhileTheFirstHoldsIt)
     try {
       run_fluid_case(c, {dir, resume, true, 0});
       ADD_FAILURE() << "a run into a held directory was not refused (resume " << resume << ")";
-    } catch (const input::InputError& e) {
+    } catch (const OutputDirectoryBusy& e) {  // exit 4 in `flocsim run`, not a case error
       EXPECT_NE(std::string(e.what()).find("another flocsim (process " + std::to_string(holder) +
                                            ") is writing to this directory"),
                 std::string::npos)
