@@ -131,9 +131,9 @@ int main(int argc, char** argv) {
   const auto save = [&](bool complete) {
     if (json_file.empty()) return;
     const std::string tmp = json_file + ".tmp";
-    std::ofstream(tmp) << nlohmann::json{{"gpu", d.name}, {"complete", complete}, {"figures", all}}
-                              .dump(2)
-                       << "\n";
+    std::ofstream(tmp)
+        << nlohmann::json{{"gpu", d.name}, {"complete", complete}, {"figures", all}}.dump(2)
+        << "\n";
     std::rename(tmp.c_str(), json_file.c_str());
   };
   for (const lattice::Extent& e : sizes)

@@ -223,8 +223,8 @@ void refuse_non_sqlite_file(const std::string& path) {
   in.read(header, sizeof header);
   if (in.gcount() < 16 || std::memcmp(header, "SQLite format 3", 16) != 0)
     throw NotADatabaseError(path +
-                  ": not an SQLite database (it does not start with the SQLite header); "
-                  "--db must name a results database written by `flocsim sweep launch`");
+                            ": not an SQLite database (it does not start with the SQLite header); "
+                            "--db must name a results database written by `flocsim sweep launch`");
 }
 
 // Checks the path before SQLite sees it, with the operating system's reason:
@@ -241,9 +241,10 @@ void check_db_path(const std::string& path, ResultsDb::Mode mode) {
     if (S_ISDIR(st.st_mode))
       throw NotADatabaseError(path + ": is a directory; --db must name a results database file");
     if (!S_ISREG(st.st_mode))
-      throw NotADatabaseError(path +
-                    ": not a regular file (a device, a pipe or a socket); --db must name a "
-                    "results database file");
+      throw NotADatabaseError(
+          path +
+          ": not a regular file (a device, a pipe or a socket); --db must name a "
+          "results database file");
     return;
   }
   const int err = errno;

@@ -89,8 +89,9 @@ constexpr const char* kPostRecord = ".flocsim-post";
 void prepare_out(const fs::path& out) {
   std::error_code ec;
   if (fs::exists(fs::symlink_status(out, ec)) && !fs::is_directory(out, ec))
-    throw input::InputError("--out " + out.string() +
-                            ": exists and is not a folder; give a folder for the tables and figures");
+    throw input::InputError(
+        "--out " + out.string() +
+        ": exists and is not a folder; give a folder for the tables and figures");
   const std::vector<fs::path> places = taken_output_places(out);
   std::vector<std::string> links, files;
   for (const fs::path& p : places) {
@@ -114,10 +115,10 @@ void prepare_out(const fs::path& out) {
         "earlier version of post wrote has no record: if these are post's, `touch " +
         (out / kPostRecord).string() + "`)");
   fs::create_directories(out, ec);
-  if (!ec)
-    try {
-      write_file(out / kPostRecord,
-                 "This folder holds the output of flocsim post, which replaces it when run again.\n");
+  if (!ec) try {
+      write_file(
+          out / kPostRecord,
+          "This folder holds the output of flocsim post, which replaces it when run again.\n");
     } catch (const std::exception& e) {
       throw input::InputError("--out " + out.string() + ": cannot write there (" + e.what() + ")");
     }
@@ -164,7 +165,6 @@ void write_tables(const std::vector<pp::RunSummary>& runs, const std::vector<std
     std::cout << left_out.size() << " unreadable row" << (left_out.size() > 1 ? "s" : "")
               << " left out of the tables: " << printable((out / "left_out.md").string()) << "\n";
 }
-
 
 int post(const std::string& what, const PostOptions& o) {
   try {

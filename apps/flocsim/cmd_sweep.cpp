@@ -180,8 +180,7 @@ std::vector<std::string> check_device(SweepOptions& o, const std::vector<orc::Ru
     try {
       cases::parse_case(c);
     } catch (const flocsim::input::InputError& e) {
-      throw flocsim::input::InputError(asked + ": grid point " + p.point.dump() + ": " +
-                                       e.what());
+      throw flocsim::input::InputError(asked + ": grid point " + p.point.dump() + ": " + e.what());
     }
   }
   std::vector<int> indices;
@@ -205,7 +204,7 @@ bool reads_flocsim_cases(const SweepOptions& o) {
 // Asked on the local backend only: a case is also checked against this
 // machine's memory, and a Slurm sweep's login node is not where it runs.
 void refuse_an_unrunnable_grid(const std::vector<orc::RunPoint>& points,
-                                const std::string& device) {
+                               const std::string& device) {
   std::string first;
   for (const orc::RunPoint& p : points) {
     try {
@@ -218,8 +217,10 @@ void refuse_an_unrunnable_grid(const std::vector<orc::RunPoint>& points,
     }
   }
   if (!points.empty())
-    throw flocsim::input::InputError("every point of the grid is refused, as `flocsim run` would "
-                                     "refuse it; the first: " + first);
+    throw flocsim::input::InputError(
+        "every point of the grid is refused, as `flocsim run` would "
+        "refuse it; the first: " +
+        first);
 }
 
 // The folder the run folders go under: made now, or refused (exit 2) before
@@ -245,8 +246,8 @@ std::vector<std::filesystem::path> make_runs_dir(const std::string& dir, bool gi
   if (!err && !fs::is_directory(dir)) err = ENOTDIR;
   if (!err && ::access(dir.c_str(), W_OK | X_OK) != 0) err = errno;
   if (err) {
-    const std::string text = what + ": cannot make or write a folder there (" +
-                             std::strerror(err) + "); give a writable folder";
+    const std::string text = what + ": cannot make or write a folder there (" + std::strerror(err) +
+                             "); give a writable folder";
     // a read-only or full file system, or one refused to this user, is the
     // place failing (exit 1, as for the database); anything else is the path
     if (err == EROFS || err == ENOSPC || err == EDQUOT || err == EACCES || err == EPERM)
@@ -483,7 +484,8 @@ const bool registered = register_command(
              const std::vector<orc::RunPoint> points = orc::expand(spec);
              // another --worker reads its cases its own way: only flocsim's are checked
              const bool flocsim_cases = reads_flocsim_cases(*o);
-             if (flocsim_cases && o->backend == "local") refuse_an_unrunnable_grid(points, o->device);
+             if (flocsim_cases && o->backend == "local")
+               refuse_an_unrunnable_grid(points, o->device);
              const std::vector<std::string> gpus = check_device(*o, points, flocsim_cases);
              check_worker(o->worker);
              const std::string runs_dir =

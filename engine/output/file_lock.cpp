@@ -31,8 +31,8 @@ FileLock::FileLock(const std::filesystem::path& path, bool wait) : lock_path_(lo
       throw std::runtime_error("cannot lock " + path.string() + " (" + lock_path_.string() +
                                "): " + std::strerror(errno));
     while (::flock(fd_, wait ? LOCK_EX : LOCK_EX | LOCK_NB) != 0) {
-      const bool no_locks_here = errno == ENOLCK || errno == ENOSYS || errno == EOPNOTSUPP ||
-                                 errno == EINVAL;
+      const bool no_locks_here =
+          errno == ENOLCK || errno == ENOSYS || errno == EOPNOTSUPP || errno == EINVAL;
       if (!wait && (errno == EWOULDBLOCK || no_locks_here)) {
         unsupported_ = no_locks_here;
         ::close(fd_);

@@ -22,7 +22,6 @@
 
 #include "engine/input/input_reader.hpp"
 #include "engine/output/file_lock.hpp"
-
 #include "engine/run/run_log.hpp"
 #include "engine/run/run_types.hpp"
 

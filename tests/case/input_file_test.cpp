@@ -152,8 +152,8 @@ TEST(InputFile, AWholeNumberWrittenWithAnExponentIsAnInteger) {
 // valid part alone; a NUL byte anywhere is refused, with where it is.
 TEST(InputFile, ANulByteIsRefusedNotTakenForTheEnd) {
   const fs::path f = write_file("nul.json", std::string("{\"scene\": \"fluid\"}\0junk", 23));
-  EXPECT_THAT(refusal_of_file(f), AllOf(HasSubstr("a NUL byte at offset 18"),
-                                        HasSubstr("JSON text never holds")));
+  EXPECT_THAT(refusal_of_file(f),
+              AllOf(HasSubstr("a NUL byte at offset 18"), HasSubstr("JSON text never holds")));
   fs::remove(f);
 }
 

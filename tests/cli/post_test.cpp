@@ -134,8 +134,8 @@ TEST_F(Post, AUsersFilesWherePostWritesAreRefusedAndKept) {
   EXPECT_EQ(again.code, 0) << again.out;
   EXPECT_EQ(t::read_text(own / "notes.txt"), "notes\n");
   // --out naming a file
-  const t::Output file = t::run(
-      flocsim({"post", "tables", "--db", db, "--out", (own / "notes.txt").string()}));
+  const t::Output file =
+      t::run(flocsim({"post", "tables", "--db", db, "--out", (own / "notes.txt").string()}));
   EXPECT_EQ(file.code, 2) << file.out;
   EXPECT_THAT(file.out, HasSubstr("exists and is not a folder"));
 }

@@ -92,7 +92,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (fake.value("busy", false)) {
-    std::cerr << "--out " << dir << ": another flocsim (process 1) is writing to this directory now\n";
+    std::cerr << "--out " << dir
+              << ": another flocsim (process 1) is writing to this directory now\n";
     return 4;
   }
 

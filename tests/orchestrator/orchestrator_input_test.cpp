@@ -413,16 +413,16 @@ TEST_F(Orchestrator, LaunchRefusesWhatCannotRunBeforeRecordingOrTimingAnything) 
     cmd.insert(cmd.end(), more.begin(), more.end());
     return t::run(flocsim(cmd));
   };
-  const std::string typo =
-      sweep_file("typo.json", R"({"name": "a", )" + base + R"(, "axes": {"fluid.viscositty": [0.1]}})");
+  const std::string typo = sweep_file(
+      "typo.json", R"({"name": "a", )" + base + R"(, "axes": {"fluid.viscositty": [0.1]}})");
   t::Output o = launch_flocsim(typo);
   EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_NE(o.out.find("every point of the grid is refused"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("did you mean fluid.viscosity?"), std::string::npos) << o.out;
   EXPECT_FALSE(fs::exists(db_));
 
-  const std::string ok =
-      sweep_file("ok.json", R"({"name": "ok", )" + base + R"(, "axes": {"fluid.viscosity": [0.1]}})");
+  const std::string ok = sweep_file(
+      "ok.json", R"({"name": "ok", )" + base + R"(, "axes": {"fluid.viscosity": [0.1]}})");
   o = launch_flocsim(ok, {"--runs-dir", typo});
   EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_NE(o.out.find("--runs-dir " + typo + ": exists and is not a folder"), std::string::npos)
@@ -444,7 +444,8 @@ TEST_F(Orchestrator, LaunchRefusesWhatCannotRunBeforeRecordingOrTimingAnything) 
                           "viscosity": 0.05}, "run": {"steps": 20}}, "axes": {"fluid.viscosity": [0.1]}})");
   o = launch_flocsim(changed);
   EXPECT_EQ(o.code, 2) << o.out;
-  EXPECT_NE(o.out.find("was launched with base.run.steps = 10; this file has 20"), std::string::npos)
+  EXPECT_NE(o.out.find("was launched with base.run.steps = 10; this file has 20"),
+            std::string::npos)
       << o.out;
   EXPECT_EQ(o.out.find("per step"), std::string::npos) << "timed before refusing:\n" << o.out;
 
@@ -475,8 +476,8 @@ TEST_F(Orchestrator, LaunchRefusesWhatCannotRunBeforeRecordingOrTimingAnything) 
 // silently ignored; both are refused now, and --help gives the defaults.
 TEST_F(Orchestrator, AnOptionTheBackendWouldIgnoreIsRefused) {
   const std::string sweep = fake_sweep({1}, 1, 1);
-  t::Output o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--no-wait", "--worker",
-                                FAKE_WORKER_EXE}));
+  t::Output o = t::run(
+      flocsim({"sweep", "launch", sweep, "--db", db_, "--no-wait", "--worker", FAKE_WORKER_EXE}));
   EXPECT_EQ(o.code, 2) << o.out;
   EXPECT_NE(o.out.find("--no-wait: only with --backend slurm"), std::string::npos) << o.out;
   o = t::run(flocsim({"sweep", "launch", sweep, "--db", db_, "--backend", "slurm", "--jobs", "4",
@@ -487,8 +488,7 @@ TEST_F(Orchestrator, AnOptionTheBackendWouldIgnoreIsRefused) {
   o = t::run(flocsim({"sweep", "launch", "--help"}));
   const auto default_of = [&](const std::string& option) {
     const auto at = o.out.find(option + " ");
-    return at == std::string::npos ? std::string()
-                                   : o.out.substr(at, o.out.find('\n', at) - at);
+    return at == std::string::npos ? std::string() : o.out.substr(at, o.out.find('\n', at) - at);
   };
   EXPECT_THAT(default_of("--grace"), testing::EndsWith("=120")) << o.out;
   EXPECT_THAT(default_of("--lease"), testing::EndsWith("=60")) << o.out;
@@ -516,7 +516,8 @@ TEST_F(Orchestrator, ARunIntoAHeldFolderExitsFourNamingTheHolder) {
   char ok = 0;
   ASSERT_EQ(::read(ready[0], &ok, 1), 1);
   ASSERT_EQ(ok, '1');
-  const t::Output o = t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", out.string()}));
+  const t::Output o =
+      t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", out.string()}));
   ::kill(holder, SIGKILL);
   ::waitpid(holder, nullptr, 0);
   ::close(ready[0]);
@@ -525,7 +526,8 @@ TEST_F(Orchestrator, ARunIntoAHeldFolderExitsFourNamingTheHolder) {
   EXPECT_NE(o.out.find("another flocsim (process " + std::to_string(holder) + ")"),
             std::string::npos)
       << o.out;
-  EXPECT_EQ(t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", out.string()})).code, 0);
+  EXPECT_EQ(t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", out.string()})).code,
+            0);
 }
 
 TEST_F(Orchestrator, WhereRefusesTextAgainstANumber) {
