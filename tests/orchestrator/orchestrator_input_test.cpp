@@ -20,12 +20,12 @@
 
 #include "db/results_db.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
-#include "engine/output/file_lock.hpp"
 #include "harness.hpp"
 #include "orchestrator/local_pool.hpp"
 #include "orchestrator/plan.hpp"
 #include "orchestrator/sweep.hpp"
 #include "orchestrator_fixture.hpp"
+#include "tests/run/folder_holder.hpp"
 
 // the fixture and its names: Orchestrator, fs, json, t (flocsim::test), ResultsDb, RunState
 using namespace flocsim::test::orchestrator_fixture;
@@ -503,25 +503,11 @@ TEST_F(Orchestrator, ARunIntoAHeldFolderExitsFourNamingTheHolder) {
                     "run": {"steps": 5}})");
   const fs::path out = dir_ / "held";
   fs::create_directories(out);
-  int ready[2];
-  ASSERT_EQ(::pipe(ready), 0);
-  const pid_t holder = ::fork();
-  ASSERT_GE(holder, 0);
-  if (holder == 0) {
-    auto lock = flocsim::output::FileLock::try_lock(out / "flocsim-run");
-    const char ok = lock ? '1' : '0';
-    [[maybe_unused]] const ssize_t w = ::write(ready[1], &ok, 1);
-    for (;;) ::pause();
-  }
-  char ok = 0;
-  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
-  ASSERT_EQ(ok, '1');
+  flocsim::testing::FolderHolder other(out);
+  const pid_t holder = other.pid();
   const t::Output o =
       t::run(flocsim({"run", (dir_ / "fluid.json").string(), "--out", out.string()}));
-  ::kill(holder, SIGKILL);
-  ::waitpid(holder, nullptr, 0);
-  ::close(ready[0]);
-  ::close(ready[1]);
+  other.kill();
   EXPECT_EQ(o.code, 4) << o.out;
   EXPECT_NE(o.out.find("another flocsim (process " + std::to_string(holder) + ")"),
             std::string::npos)

@@ -19,11 +19,11 @@
 #include "engine/input/input_reader.hpp"
 #include "engine/lattice_gpu/gpu_runtime.hpp"
 #include "engine/output/field_snapshots.hpp"
-#include "engine/output/file_lock.hpp"
 #include "engine/output/hdf5_file.hpp"
 #include "engine/process/stop_signal.hpp"
 #include "engine/run/coupled_step.hpp"
 #include "engine/run/output_directory.hpp"
+#include "tests/run/folder_holder.hpp"
 #include "tests/run/scratch_dir.hpp"
 
 namespace flocsim::run {
@@ -195,19 +195,8 @@ TEST(OutputDirectory, ASecondRunInTheSameDirectoryIsRefusedWhileTheFirstHoldsIt)
   const cases::FluidCase c = shear_wave_case("double");
   const fs::path dir = fresh_dir("held");
   fs::create_directories(dir);
-  int ready[2];
-  ASSERT_EQ(::pipe(ready), 0);
-  const pid_t holder = ::fork();
-  ASSERT_GE(holder, 0);
-  if (holder == 0) {  // the other flocsim: takes the lock, says so, waits to be killed
-    auto lock = output::FileLock::try_lock(dir / "flocsim-run");
-    const char ok = lock ? '1' : '0';
-    [[maybe_unused]] const ssize_t w = ::write(ready[1], &ok, 1);
-    for (;;) ::pause();
-  }
-  char ok = 0;
-  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
-  ASSERT_EQ(ok, '1');
+  flocsim::testing::FolderHolder other(dir);  // the other flocsim
+  const pid_t holder = other.pid();
   for (const bool resume : {false, true}) {
     try {
       run_fluid_case(c, {dir, resume, true, 0});
@@ -221,13 +210,10 @@ TEST(OutputDirectory, ASecondRunInTheSameDirectoryIsRefusedWhileTheFirstHoldsIt)
   }
   EXPECT_FALSE(fs::exists(dir / "run.log"));  // refused before the directory was touched
   EXPECT_FALSE(fs::exists(dir / kRunRecord));
-  ::kill(holder, SIGKILL);
-  ::waitpid(holder, nullptr, 0);
+  other.kill();
   EXPECT_TRUE(fs::exists(dir / ".flocsim-run.lock"));  // a killed holder leaves its file
   EXPECT_EQ(run_fluid_case(c, {dir, false, true, 0}).outcome, RunOutcome::completed);
   EXPECT_FALSE(fs::exists(dir / ".flocsim-run.lock"));
-  ::close(ready[0]);
-  ::close(ready[1]);
   fs::remove_all(dir);
 }
 
